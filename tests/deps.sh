@@ -1,0 +1,22 @@
+#!/bin/sh
+# Installs the libraries the build needs when they are missing (Debian/Ubuntu).
+# Usage: tests/deps.sh build|test
+set -u
+need=""
+pkg-config --exists libpng 2>/dev/null || need="$need libpng-dev"
+pkg-config --exists zlib 2>/dev/null   || need="$need zlib1g-dev"
+command -v pkg-config >/dev/null       || need="$need pkg-config"
+command -v cc >/dev/null               || need="$need gcc"
+if [ "${1:-build}" = test ]; then
+    pkg-config --exists cmocka 2>/dev/null || need="$need libcmocka-dev"
+fi
+[ -z "$need" ] && exit 0
+if ! command -v apt-get >/dev/null; then
+    echo "deps: missing:$need; install them with your package manager" >&2
+    exit 1
+fi
+sudo=""
+[ "$(id -u)" -ne 0 ] && sudo=sudo
+echo "deps: installing$need with apt-get" >&2
+$sudo apt-get update -qq || exit 1
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq $need >/dev/null || exit 1
