@@ -122,7 +122,7 @@ $(B)/bin/%: $(B)/bench/%_main.o $(LIBS)
 
 $(B)/tests/%: $(B)/tests/%.o $(LIB_TEST) $(LIBS)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIB_TEST) $(LIBS) $(LDLIBS) -lcmocka
+	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIB_TEST) $(LIBS) $(LDLIBS) -lcmocka -lmpfr -lgmp
 
 $(B)/tests/replay_%: $(B)/tests/fuzz/%.o $(B)/tests/fuzz/replay_main.o $(LIB_TEST) $(LIBS)
 	@mkdir -p $(dir $@)

@@ -9,6 +9,7 @@ command -v pkg-config >/dev/null       || need="$need pkg-config"
 command -v cc >/dev/null               || need="$need gcc"
 if [ "${1:-build}" = test ]; then
     pkg-config --exists cmocka 2>/dev/null || need="$need libcmocka-dev"
+    [ -f /usr/include/mpfr.h ]             || need="$need libmpfr-dev"  # interval tests check against MPFR
 fi
 [ -z "$need" ] && exit 0
 if ! command -v apt-get >/dev/null; then
