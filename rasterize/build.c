@@ -1,0 +1,578 @@
+/* build: one recursive subdivision of space around f = 0, parallel over
+ * subtrees, streamed in Morton order into the .oct writer.
+ *
+ * Soundness. A cell is dropped only when an enclosure of f over it (interval
+ * arithmetic, Duff 1992; the first-order Taylor form at the voxels; or the
+ * Lipschitz bound of Kalra & Barr 1989) proves f != 0 everywhere in it, so no
+ * voxel holding a point of the surface is lost. The surface is the set of
+ * points of `bounds` where f is defined and equal to 0: a cell where f is
+ * defined nowhere (the NaN interval) holds no such point and is dropped; a
+ * cell where f may be undefined somewhere is judged by the enclosure of its
+ * defined part (interval.h) and counted in nan_cells.
+ *
+ * Order. Tasks are the cells of depth S (up to 512); a worker builds a whole
+ * subtree depth-first, visiting children in slot order, which emits every
+ * depth's nodes in Morton order. The calling thread appends finished
+ * subtrees to the writer in task order, so the file does not depend on the
+ * number of threads, then adds the few nodes above depth S. */
+#include "rasterize/build.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/interval.h"
+#include "common/tape.h"
+#include "format/oct_normal.h"
+
+#define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
+#define NEWTON_STEPS 4        /* guarded Newton steps from the voxel centre onto f = 0 */
+#define TAYLOR_DEPTHS 2       /* the Taylor test runs on the voxels and their parents */
+#define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
+
+/* --- growable buffers -------------------------------------------------- */
+
+typedef struct buf {
+    uint8_t *p;
+    size_t n, cap; /* in bytes */
+} buf;
+
+static int buf_push(buf *b, const void *data, size_t n)
+{
+    if (b->n + n > b->cap) {
+        size_t cap = b->cap ? b->cap * 2 : 256;
+        while (cap < b->n + n)
+            cap *= 2;
+        uint8_t *p = realloc(b->p, cap);
+        if (!p)
+            return -1;
+        b->p = p;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->n, data, n);
+    b->n += n;
+    return 0;
+}
+
+static void buf_free(buf *b)
+{
+    free(b->p);
+    memset(b, 0, sizeof *b);
+}
+
+/* --- shared, read-only context ----------------------------------------- */
+
+typedef struct build_ctx {
+    const scene *sc;
+    const build_params *par;
+    unsigned levels, nsurf, task_depth;
+    double origin[3], edge;
+    double bmax[3];            /* bounds' max corner: cells are clipped to it */
+    const tape **full;         /* full tape of each surface */
+    uint32_t *tape_off;        /* offset of each surface's prune buffer */
+    uint32_t tape_total;       /* sum of tape lengths */
+    uint32_t max_len;
+    uint8_t *has_minmax;       /* pruning only pays where a min or max can be decided */
+} build_ctx;
+
+/* What one task produced: the subtree below one depth-S cell. */
+typedef struct task_out {
+    buf masks[OCT_MAX_LEVELS];
+    buf voxels, surfaces;
+    int nonempty;
+    int done;
+} task_out;
+
+/* --- per-thread state --------------------------------------------------- */
+
+typedef struct worker {
+    const build_ctx *c;
+    interval *slots, *slots2;
+    tape_idual *islots;
+    tape_dual *dslots;
+    uint32_t *scratch;
+    tape_insn *prune;      /* [(levels + 2) * tape_total] */
+    tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
+    uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
+    unsigned *nact;        /* [levels + 2] */
+    task_out *out;
+    build_stats st;
+    int failed;
+} worker;
+
+static int worker_init(worker *wk, const build_ctx *c)
+{
+    memset(wk, 0, sizeof *wk);
+    wk->c = c;
+    size_t depths = (size_t)c->levels + 2, len = c->max_len ? c->max_len : 1;
+    wk->slots = malloc(len * sizeof *wk->slots);
+    wk->slots2 = malloc(len * sizeof *wk->slots2);
+    wk->islots = malloc(len * sizeof *wk->islots);
+    wk->dslots = malloc(len * sizeof *wk->dslots);
+    wk->scratch = malloc(len * sizeof *wk->scratch);
+    wk->prune = malloc(depths * c->tape_total * sizeof *wk->prune);
+    wk->tapes = calloc(depths * c->nsurf, sizeof *wk->tapes);
+    wk->act = calloc(depths * c->nsurf, 1);
+    wk->nact = calloc(depths, sizeof *wk->nact);
+    if (!wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->scratch || !wk->prune ||
+        !wk->tapes || !wk->act || !wk->nact)
+        return -1;
+    for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
+        wk->tapes[s] = *c->full[s];
+        wk->act[s] = (uint8_t)s;
+    }
+    wk->nact[0] = c->nsurf;
+    return 0;
+}
+
+static void worker_free(worker *wk)
+{
+    free(wk->slots); free(wk->slots2); free(wk->islots); free(wk->dslots);
+    free(wk->scratch); free(wk->prune); free(wk->tapes); free(wk->act); free(wk->nact);
+}
+
+/* --- cell tests ----------------------------------------------------------- */
+
+/* World box of a cell, rounded outward and clipped to bounds. 0 if empty. */
+static int cell_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], interval box[3],
+                    double centre[3])
+{
+    double h = ldexp(c->edge, -(int)depth); /* exact: a power-of-two scaling */
+    for (int k = 0; k < 3; k++) {
+        double lo = nextafter(c->origin[k] + (double)cell[k] * h, -INFINITY);
+        double hi = nextafter(c->origin[k] + (double)(cell[k] + 1) * h, INFINITY);
+        if (hi > c->bmax[k])
+            hi = c->bmax[k];
+        if (lo > hi)
+            return 0;
+        box[k].lo = lo;
+        box[k].hi = hi;
+        centre[k] = 0.5 * (lo + hi);
+    }
+    return 1;
+}
+
+/* Enclosure of f(centre) + grad f(box) . (box - centre): the mean-value
+ * form. Returns 1 when it proves f != 0 on the box. */
+static int taylor_excludes_zero(worker *wk, const tape *t, const interval box[3],
+                                const double centre[3], int lipschitz)
+{
+    interval g[3];
+    unsigned fl = 0;
+    tape_eval_interval_grad(t, box, g, wk->islots, &fl);
+    wk->st.gradient_evals++;
+    if (fl)
+        return 0;
+    interval cb[3];
+    for (int k = 0; k < 3; k++)
+        cb[k].lo = cb[k].hi = centre[k];
+    unsigned fc_fl = 0;
+    interval fc = tape_eval_interval(t, cb, wk->slots2, &fc_fl);
+    if (fc_fl || interval_is_nan(fc))
+        return 0;
+    if (lipschitz) { /* Kalra-Barr: |f(p) - f(c)| <= sum_k sup|df/dk| * r_k */
+        double bound = 0.0;
+        for (int k = 0; k < 3; k++) {
+            double gk = fmax(fabs(g[k].lo), fabs(g[k].hi));
+            double rk = fmax(centre[k] - box[k].lo, box[k].hi - centre[k]);
+            bound += gk * rk;
+        }
+        if (!isfinite(bound))
+            return 0;
+        bound = bound * (1.0 + 0x1p-40) + 0x1p-1000; /* cover the rounding of the sum */
+        return fc.lo > bound || fc.hi < -bound;
+    }
+    unsigned sfl = 0;
+    interval sum = fc;
+    for (int k = 0; k < 3; k++) {
+        interval r = {nextafter(box[k].lo - centre[k], -INFINITY),
+                      nextafter(box[k].hi - centre[k], INFINITY)};
+        sum = interval_add(sum, interval_mul(g[k], r, &sfl), &sfl);
+    }
+    if (sfl || interval_is_nan(sum))
+        return 0;
+    return sum.lo > 0.0 || sum.hi < 0.0;
+}
+
+/* Tests the cell (depth, cell) for every surface that may cross its parent
+ * (lists at index pidx). Fills the cell's lists at index depth + 1 and, when
+ * it will be subdivided, its pruned tapes. Returns how many surfaces may
+ * cross it. */
+static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3])
+{
+    const build_ctx *c = wk->c;
+    interval box[3];
+    double centre[3];
+    if (!cell_box(c, depth, cell, box, centre))
+        return 0;
+    unsigned idx = depth + 1, n = 0, ns = c->nsurf;
+    int lipschitz = c->par->method == BUILD_LIPSCHITZ;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k];
+        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+        unsigned flags = 0;
+        interval v = tape_eval_interval(t, box, wk->slots, &flags);
+        wk->st.interval_evals++;
+        wk->st.insns_evaluated += t->n;
+        wk->st.insns_full += c->full[s]->n;
+        if (interval_is_nan(v)) { /* defined nowhere in the cell: no surface point */
+            wk->st.nan_cells++;
+            continue;
+        }
+        if (flags)
+            wk->st.nan_cells++;
+        if (v.lo > 0.0 || v.hi < 0.0)
+            continue;
+        if (!flags && (lipschitz || depth + TAYLOR_DEPTHS > c->levels) &&
+            taylor_excludes_zero(wk, t, box, centre, lipschitz)) {
+            if (depth == c->levels)
+                wk->st.taylor_drops++;
+            continue;
+        }
+        wk->act[(size_t)idx * ns + n++] = (uint8_t)s;
+        tape *child = &wk->tapes[(size_t)idx * ns + s];
+        if (depth < c->levels && c->has_minmax[s]) {
+            tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
+            tape_prune(t, wk->slots, flags, out, wk->scratch, child);
+        } else {
+            *child = *t;
+        }
+    }
+    wk->nact[idx] = n;
+    return n;
+}
+
+/* --- voxels ------------------------------------------------------------- */
+
+static int finite3(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+/* Normal and plane offset of the voxel for surface tape t: guarded Newton
+ * steps from the centre towards f = 0, kept inside the voxel; the normal is
+ * the normalised gradient there, the offset the signed distance (in voxel
+ * edges) from the centre to the linearised surface along it. A gradient that
+ * is zero or not finite there and at the centre falls back to +z with offset
+ * 0 (counted in normal_fallbacks). */
+static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], const double centre[3],
+                             double h)
+{
+    double p[3] = {centre[0], centre[1], centre[2]}, g[3], f = 0.0;
+    for (int step = 0; step < NEWTON_STEPS; step++) {
+        f = tape_eval_grad(t, p, g, wk->dslots);
+        wk->st.point_evals++;
+        double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
+            break;
+        for (int k = 0; k < 3; k++)
+            p[k] = fmin(fmax(p[k] - f / g2 * g[k], box[k].lo), box[k].hi);
+    }
+    f = tape_eval_grad(t, p, g, wk->dslots);
+    wk->st.point_evals++;
+    double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g) || !isfinite(f)) {
+        memcpy(p, centre, sizeof p);
+        f = tape_eval_grad(t, p, g, wk->dslots);
+        wk->st.point_evals++;
+        g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g)) {
+            wk->st.normal_fallbacks++;
+            static const double up[3] = {0.0, 0.0, 1.0};
+            return oct_voxel_pack(up, 0.0);
+        }
+        if (!isfinite(f))
+            f = 0.0;
+    }
+    double len = sqrt(g2), n[3], d = 0.0;
+    for (int k = 0; k < 3; k++) {
+        n[k] = g[k] / len;
+        double s = p[k] - f / g2 * g[k]; /* surface point of the linearisation */
+        d += n[k] * (s - centre[k]);
+    }
+    d /= h;
+    if (!isfinite(d))
+        d = 0.0;
+    d = fmin(fmax(d, -HALF_DIAGONAL), HALF_DIAGONAL);
+    return oct_voxel_pack(n, d);
+}
+
+/* Appends the voxel's record; with several surfaces it belongs to the one
+ * nearest its centre by the first-order distance |f| / |grad f|. */
+static int emit_voxel(worker *wk, const uint64_t cell[3])
+{
+    const build_ctx *c = wk->c;
+    unsigned idx = c->levels + 1, ns = c->nsurf;
+    interval box[3];
+    double centre[3];
+    cell_box(c, c->levels, cell, box, centre);
+    unsigned best = wk->act[(size_t)idx * ns];
+    if (wk->nact[idx] > 1) {
+        double best_dist = INFINITY;
+        for (unsigned k = 0; k < wk->nact[idx]; k++) {
+            unsigned s = wk->act[(size_t)idx * ns + k];
+            double g[3];
+            double f = tape_eval_grad(&wk->tapes[(size_t)idx * ns + s], centre, g, wk->dslots);
+            wk->st.point_evals++;
+            double dist = fabs(f) / sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+            if (isnan(dist))
+                dist = INFINITY;
+            if (k == 0 || dist < best_dist) {
+                best_dist = dist;
+                best = s;
+            }
+        }
+    }
+    uint32_t rec = voxel_record(wk, &wk->tapes[(size_t)idx * ns + best], box, centre,
+                                ldexp(c->edge, -(int)c->levels));
+    uint8_t surf = (uint8_t)best;
+    if (buf_push(&wk->out->voxels, &rec, sizeof rec) ||
+        (ns > 1 && buf_push(&wk->out->surfaces, &surf, 1))) {
+        wk->failed = 1;
+        return 0;
+    }
+    wk->st.voxels++;
+    return 1;
+}
+
+/* Builds the subtree of a cell already tested non-empty; returns its child
+ * mask (0 when nothing below it survived). */
+static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
+{
+    const unsigned levels = wk->c->levels;
+    uint8_t mask = 0;
+    for (unsigned i = 0; i < 8 && !wk->failed; i++) {
+        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
+        if (!test_cell(wk, depth + 1, depth + 1, cc))
+            continue;
+        if (depth + 1 == levels ? emit_voxel(wk, cc) : visit_node(wk, depth + 1, cc))
+            mask |= (uint8_t)(1u << i);
+    }
+    if (mask) {
+        if (buf_push(&wk->out->masks[depth], &mask, 1)) {
+            wk->failed = 1;
+            return 0;
+        }
+        wk->st.nodes++;
+    }
+    return wk->failed ? 0 : mask;
+}
+
+static void morton_decode(uint64_t m, unsigned depth, uint64_t cell[3])
+{
+    cell[0] = cell[1] = cell[2] = 0;
+    for (unsigned b = 0; b < depth; b++) {
+        cell[0] |= ((m >> (3 * b)) & 1) << b;
+        cell[1] |= ((m >> (3 * b + 1)) & 1) << b;
+        cell[2] |= ((m >> (3 * b + 2)) & 1) << b;
+    }
+}
+
+static void run_task(worker *wk, uint64_t task, task_out *out)
+{
+    const build_ctx *c = wk->c;
+    uint64_t cell[3];
+    morton_decode(task, c->task_depth, cell);
+    wk->out = out;
+    if (test_cell(wk, 0, c->task_depth, cell))
+        out->nonempty = visit_node(wk, c->task_depth, cell) != 0;
+}
+
+/* --- threads ----------------------------------------------------------------- */
+
+typedef struct pool {
+    const build_ctx *c;
+    task_out *tasks;
+    uint64_t ntasks;
+    atomic_uint_fast64_t next;
+    pthread_mutex_t lock;
+    pthread_cond_t cond;
+    build_stats st;
+    int failed;
+} pool;
+
+static void stats_add(build_stats *a, const build_stats *b)
+{
+    a->voxels += b->voxels;
+    a->nodes += b->nodes;
+    a->interval_evals += b->interval_evals;
+    a->gradient_evals += b->gradient_evals;
+    a->point_evals += b->point_evals;
+    a->insns_evaluated += b->insns_evaluated;
+    a->insns_full += b->insns_full;
+    a->taylor_drops += b->taylor_drops;
+    a->nan_cells += b->nan_cells;
+    a->normal_fallbacks += b->normal_fallbacks;
+}
+
+static void *worker_main(void *arg)
+{
+    pool *pl = arg;
+    worker wk;
+    int failed = worker_init(&wk, pl->c) != 0;
+    for (;;) {
+        uint64_t t = atomic_fetch_add(&pl->next, 1);
+        if (t >= pl->ntasks)
+            break;
+        if (!failed) {
+            run_task(&wk, t, &pl->tasks[t]);
+            failed = wk.failed;
+        }
+        pthread_mutex_lock(&pl->lock);
+        pl->tasks[t].done = 1;
+        pl->failed |= failed;
+        pthread_cond_broadcast(&pl->cond);
+        pthread_mutex_unlock(&pl->lock);
+    }
+    pthread_mutex_lock(&pl->lock);
+    stats_add(&pl->st, &wk.st);
+    pl->failed |= failed;
+    pthread_mutex_unlock(&pl->lock);
+    worker_free(&wk);
+    return NULL;
+}
+
+/* Nodes above the task depth, from which tasks came out non-empty. */
+static oct_err add_upper_levels(const build_ctx *c, const uint8_t *nonempty, oct_writer *w,
+                                build_stats *st)
+{
+    uint64_t n = (uint64_t)1 << (3 * c->task_depth);
+    uint8_t *cur = malloc(n), *up = malloc(n / 8 + 1);
+    if (!cur || !up) {
+        free(cur); free(up);
+        return OCT_ENOMEM;
+    }
+    memcpy(cur, nonempty, n);
+    oct_err err = OCT_OK;
+    for (unsigned d = c->task_depth; d-- > 0 && err == OCT_OK;) {
+        n /= 8;
+        for (uint64_t u = 0; u < n && err == OCT_OK; u++) {
+            uint8_t mask = 0;
+            for (unsigned i = 0; i < 8; i++)
+                mask |= (uint8_t)((cur[8 * u + i] ? 1u : 0u) << i);
+            up[u] = mask != 0;
+            if (mask) {
+                err = oct_writer_add_masks(w, d, &mask, 1);
+                st->nodes++;
+            }
+        }
+        memcpy(cur, up, n);
+    }
+    free(cur);
+    free(up);
+    return err;
+}
+
+void build_cube(const scene *sc, double origin[3], double *edge)
+{
+    double e = 0.0;
+    for (int k = 0; k < 3; k++) {
+        origin[k] = sc->lo[k];
+        e = fmax(e, sc->hi[k] - sc->lo[k]);
+    }
+    *edge = e;
+}
+
+static int tape_has_minmax(const tape *t)
+{
+    for (uint32_t i = 0; i < t->n; i++)
+        if (t->insn[i].op == TAPE_MIN || t->insn[i].op == TAPE_MAX)
+            return 1;
+    return 0;
+}
+
+oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats)
+{
+    memset(stats, 0, sizeof *stats);
+    build_ctx c;
+    memset(&c, 0, sizeof c);
+    c.sc = sc;
+    c.par = p;
+    c.levels = p->levels;
+    c.nsurf = (unsigned)sc->nsurfaces;
+    c.task_depth = p->levels - 1 < TASK_DEPTH ? p->levels - 1 : TASK_DEPTH;
+    build_cube(sc, c.origin, &c.edge);
+    for (int k = 0; k < 3; k++)
+        c.bmax[k] = sc->hi[k];
+
+    oct_err err = OCT_ENOMEM;
+    pool pl;
+    memset(&pl, 0, sizeof pl);
+    uint8_t *nonempty = NULL;
+    pthread_t *th = NULL;
+    unsigned started = 0;
+    c.full = calloc(c.nsurf, sizeof *c.full);
+    c.tape_off = calloc(c.nsurf, sizeof *c.tape_off);
+    c.has_minmax = calloc(c.nsurf, 1);
+    if (!c.full || !c.tape_off || !c.has_minmax)
+        goto done;
+    for (unsigned s = 0; s < c.nsurf; s++) {
+        c.full[s] = &sc->surfaces[s].tape;
+        c.tape_off[s] = c.tape_total;
+        c.tape_total += c.full[s]->n;
+        if (c.full[s]->n > c.max_len)
+            c.max_len = c.full[s]->n;
+        c.has_minmax[s] = (uint8_t)tape_has_minmax(c.full[s]);
+    }
+
+    pl.c = &c;
+    pl.ntasks = (uint64_t)1 << (3 * c.task_depth);
+    pl.tasks = calloc(pl.ntasks, sizeof *pl.tasks);
+    nonempty = calloc(pl.ntasks, 1);
+    th = calloc(p->threads, sizeof *th);
+    if (!pl.tasks || !nonempty || !th)
+        goto done;
+    atomic_init(&pl.next, 0);
+    pthread_mutex_init(&pl.lock, NULL);
+    pthread_cond_init(&pl.cond, NULL);
+    for (; started < p->threads; started++)
+        if (pthread_create(&th[started], NULL, worker_main, &pl) != 0)
+            break;
+    if (started == 0) {
+        worker_main(&pl); /* no thread could start: do the work here */
+    }
+
+    /* Append finished subtrees in task order while the workers go on. */
+    err = OCT_OK;
+    for (uint64_t t = 0; t < pl.ntasks; t++) {
+        pthread_mutex_lock(&pl.lock);
+        while (!pl.tasks[t].done)
+            pthread_cond_wait(&pl.cond, &pl.lock);
+        int failed = pl.failed;
+        pthread_mutex_unlock(&pl.lock);
+        task_out *o = &pl.tasks[t];
+        if (failed && err == OCT_OK)
+            err = OCT_ENOMEM;
+        if (err == OCT_OK && o->nonempty) {
+            nonempty[t] = 1;
+            for (unsigned d = c.task_depth; d < c.levels && err == OCT_OK; d++)
+                err = oct_writer_add_masks(w, d, o->masks[d].p, o->masks[d].n);
+            if (err == OCT_OK)
+                err = oct_writer_add_voxels(w, (const uint32_t *)(const void *)o->voxels.p,
+                                            c.nsurf > 1 ? o->surfaces.p : NULL,
+                                            o->voxels.n / sizeof(uint32_t));
+        }
+        for (unsigned d = 0; d < OCT_MAX_LEVELS; d++)
+            buf_free(&o->masks[d]);
+        buf_free(&o->voxels);
+        buf_free(&o->surfaces);
+        if (p->progress)
+            p->progress(p->progress_ctx, (double)(t + 1) / (double)pl.ntasks);
+    }
+    for (unsigned i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    if (pl.failed && err == OCT_OK)
+        err = OCT_ENOMEM;
+    stats_add(stats, &pl.st);
+    if (err == OCT_OK)
+        err = add_upper_levels(&c, nonempty, w, stats);
+    pthread_mutex_destroy(&pl.lock);
+    pthread_cond_destroy(&pl.cond);
+done:
+    free(th);
+    free(nonempty);
+    free(pl.tasks);
+    free(c.full);
+    free(c.tape_off);
+    free(c.has_minmax);
+    return err;
+}

@@ -1,0 +1,49 @@
+/* build: subdivide space once around the scene's surfaces (Stolte & Caubet
+ * section 2; Duff 1992 interval subdivision, or Kalra & Barr 1989 Lipschitz
+ * bounds) and stream the non-empty voxels into an oct_writer. */
+#ifndef BUILD_H
+#define BUILD_H
+
+#include <stdint.h>
+
+#include "common/scene.h"
+#include "format/oct.h"
+
+typedef enum build_method {
+    BUILD_INTERVAL,  /* drop a cell when f's interval over it excludes 0 */
+    BUILD_LIPSCHITZ  /* drop a cell when |f(centre)| exceeds the gradient bound times its half-size */
+} build_method;
+
+typedef struct build_params {
+    unsigned levels;     /* 1..OCT_MAX_LEVELS */
+    build_method method;
+    unsigned threads;    /* worker threads, >= 1; the output does not depend on it */
+    /* Called from the calling thread with the fraction of work done (0..1);
+     * may be NULL. */
+    void (*progress)(void *ctx, double fraction);
+    void *progress_ctx;
+} build_params;
+
+/* What the build did, for the summary and the benchmark. */
+typedef struct build_stats {
+    uint64_t voxels;
+    uint64_t nodes;
+    uint64_t interval_evals;     /* interval evaluations of f over a cell */
+    uint64_t gradient_evals;     /* interval-gradient evaluations (Taylor or Lipschitz tests) */
+    uint64_t point_evals;        /* point/gradient evaluations for normals */
+    uint64_t insns_evaluated;    /* tape instructions run by the interval evaluations */
+    uint64_t insns_full;         /* what they would have been without pruning */
+    uint64_t taylor_drops;       /* voxels the interval kept and the Taylor form dropped */
+    uint64_t nan_cells;          /* cells where f may be undefined (kept, subdivided) */
+    uint64_t normal_fallbacks;   /* voxels whose gradient was zero or not finite */
+} build_stats;
+
+/* The cube the grid covers: min corner of `bounds`, edge = its longest side. */
+void build_cube(const scene *sc, double origin[3], double *edge);
+
+/* Runs the whole subdivision and appends every node and voxel to `w`
+ * (created by the caller with the same levels and cube). Returns OCT_OK,
+ * OCT_ENOMEM, or the writer's error. *stats is filled in either way. */
+oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats);
+
+#endif
