@@ -13,7 +13,8 @@
 #include <unistd.h>
 
 struct atomic_file {
-    FILE *fp;
+    FILE *fp;  /* a cookie stream over fd, so the fault hook sees every write */
+    int fd;
     char *target;
     char *tmp;
     char *dir;
@@ -123,6 +124,38 @@ static char *dir_of(const char *path)
     return strndup(path, (size_t)(slash - path));
 }
 
+static ssize_t cookie_write(void *cookie, const char *data, size_t n)
+{
+    atomic_file *af = cookie;
+    size_t done = 0;
+    if (fault_check("write") != 0)
+        return -1;
+    while (done < n) {
+        ssize_t w = write(af->fd, data + done, n - done);
+        if (w < 0) {
+            if (errno == EINTR)
+                continue;
+            return done ? (ssize_t)done : -1;
+        }
+        done += (size_t)w;
+    }
+    return (ssize_t)n;
+}
+
+static int cookie_close(void *cookie)
+{
+    atomic_file *af = cookie;
+    int fd = af->fd;
+    af->fd = -1;
+    if (fault_check("close") != 0) {
+        int e = errno;
+        close(fd);
+        errno = e;
+        return -1;
+    }
+    return close(fd);
+}
+
 atomic_file *atomic_file_open(const char *target_path)
 {
     atomic_file *af = calloc(1, sizeof *af);
@@ -150,7 +183,9 @@ atomic_file *atomic_file_open(const char *target_path)
     mode_t mask = umask(0); /* mkstemp makes 0600; outputs are ordinary files */
     umask(mask);
     fchmod(fd, 0666 & ~mask);
-    af->fp = fdopen(fd, "wb");
+    af->fd = fd;
+    cookie_io_functions_t io = {NULL, cookie_write, NULL, cookie_close};
+    af->fp = fopencookie(af, "wb", io);
     if (!af->fp) {
         int e = errno;
         close(fd);
@@ -165,8 +200,6 @@ FILE *atomic_file_stream(atomic_file *af) { return af->fp; }
 
 int atomic_file_write(atomic_file *af, const void *data, size_t n)
 {
-    if (fault_check("write") != 0)
-        return -1;
     if (n && fwrite(data, 1, n, af->fp) != n)
         return -1;
     return 0;
@@ -187,22 +220,15 @@ static void release(atomic_file *af, int remove_tmp)
 int atomic_file_commit(atomic_file *af, const char **failed_op)
 {
     const char *op = "write";
-    int fd = fileno(af->fp);
     if (fflush(af->fp) != 0 || ferror(af->fp))
         goto fail;
     op = "fsync";
-    if (fault_check("fsync") != 0 || fsync(fd) != 0)
+    if (fault_check("fsync") != 0 || fsync(af->fd) != 0)
         goto fail;
     op = "close";
     FILE *fp = af->fp;
     af->fp = NULL;
-    if (fault_check("close") != 0) {
-        int e = errno;
-        fclose(fp);
-        errno = e;
-        goto fail;
-    }
-    if (fclose(fp) != 0)
+    if (fclose(fp) != 0) /* cookie_close closes the descriptor */
         goto fail;
     op = "rename";
     if (fault_check("rename") != 0 || rename(af->tmp, af->target) != 0)
