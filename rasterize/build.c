@@ -29,6 +29,7 @@
 
 #define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
 #define NEWTON_STEPS 4        /* guarded Newton steps from the voxel centre onto f = 0 */
+#define NEWTON_TOL 1e-3       /* stop once a step is below this fraction of a voxel */
 #define TAYLOR_DEPTHS 2       /* the Taylor test runs on the voxels and their parents */
 #define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
 
@@ -264,8 +265,14 @@ static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], c
         double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
         if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
             break;
-        for (int k = 0; k < 3; k++)
-            p[k] = fmin(fmax(p[k] - f / g2 * g[k], box[k].lo), box[k].hi);
+        double moved = 0.0;
+        for (int k = 0; k < 3; k++) {
+            double q = fmin(fmax(p[k] - f / g2 * g[k], box[k].lo), box[k].hi);
+            moved = fmax(moved, fabs(q - p[k]));
+            p[k] = q;
+        }
+        if (moved < NEWTON_TOL * h)
+            break; /* f and g at p are within the tolerance of the last ones */
     }
     f = tape_eval_grad(t, p, g, wk->dslots);
     wk->st.point_evals++;

@@ -1,5 +1,6 @@
 /* rasterize: scene file -> sparse voxel octree (.oct), written atomically. */
 #include <errno.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,11 +39,15 @@ static const char help_text[] =
     "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 
-static int usage_error(const char *fmt, const char *arg)
+static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int usage_error(const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
     fprintf(stderr, "%s: ", diag_progname());
-    fprintf(stderr, fmt, arg);
+    vfprintf(stderr, fmt, ap);
     fprintf(stderr, "\n%s", usage_text);
+    va_end(ap);
     return EXIT_USAGE;
 }
 
