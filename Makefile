@@ -82,7 +82,8 @@ FUZZ_TIME   ?= 60
 
 .PHONY: all test demo bench bench-quick fuzz fuzz-run clean install deps deps-test tools
 .DEFAULT_GOAL := all
-.SECONDARY:
+# Keep objects that only pattern rules mention (test and fuzz mains).
+.PRECIOUS: $(B)/%.o
 
 ifeq ($(VARIANT),rel)
 all: $(patsubst $(B)/bin/%,bin/%,$(PROGRAMS))
