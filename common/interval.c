@@ -8,24 +8,13 @@
 #include <string.h>
 
 
-/* One step outward, by stepping the bit pattern (no libm call: it dominated
- * the rasterizer's profile). Values below the smallest normal step to
- * +-DBL_MIN or 0 instead of to a neighbouring subnormal: still outward, and
- * it keeps subnormal operands, which cost a microcode assist per operation
- * on x86, out of every later multiplication. inf and NaN stay. */
-static inline double up(double x)
-{
-    if (!(x < INFINITY)) /* +inf or NaN */
-        return x;
-    if (fabs(x) < DBL_MIN)
-        return x < 0.0 ? 0.0 : DBL_MIN;
-    uint64_t b;
-    memcpy(&b, &x, sizeof b);
-    b = x > 0.0 ? b + 1 : b - 1;
-    memcpy(&x, &b, sizeof x);
-    return x;
-}
-static inline double dn(double x) { return -up(-x); }
+/* Outward rounding of one result; see interval_up in interval.h. */
+static inline double up(double x) { return interval_up(x); }
+static inline double dn(double x) { return interval_down(x); }
+/* min and max for operands known not to be NaN: plain compares, where
+ * fmin/fmax are libm calls (their NaN rules stop the compiler inlining them). */
+static inline double min2(double a, double b) { return a < b ? a : b; }
+static inline double max2(double a, double b) { return a > b ? a : b; }
 static double dn2(double x) { return dn(dn(x)); }
 static double up2(double x) { return up(up(x)); }
 static int isnan_iv(interval a) { return a.lo != a.lo || a.hi != a.hi; }
@@ -91,8 +80,8 @@ interval interval_mul(interval a, interval b, unsigned *flags)
     int bad = 0;
     double p1 = mul0(a.lo, b.lo, &bad), p2 = mul0(a.lo, b.hi, &bad);
     double p3 = mul0(a.hi, b.lo, &bad), p4 = mul0(a.hi, b.hi, &bad);
-    double lo = fmin(fmin(p1, p2), fmin(p3, p4));
-    double hi = fmax(fmax(p1, p2), fmax(p3, p4));
+    double lo = min2(min2(p1, p2), min2(p3, p4));
+    double hi = max2(max2(p1, p2), max2(p3, p4));
     if (bad)
         *flags |= INTERVAL_MAYBE_NAN;
     return mk(dn(lo), up(hi));
@@ -114,7 +103,7 @@ interval interval_div(interval a, interval b, unsigned *flags)
         *flags |= INTERVAL_MAYBE_NAN;
         return mk(-INFINITY, INFINITY);
     }
-    return mk(dn(fmin(fmin(q1, q2), fmin(q3, q4))), up(fmax(fmax(q1, q2), fmax(q3, q4))));
+    return mk(dn(min2(min2(q1, q2), min2(q3, q4))), up(max2(max2(q1, q2), max2(q3, q4))));
 }
 
 interval interval_sqr(interval a, unsigned *flags)
@@ -221,7 +210,7 @@ static interval sin_or_cos(interval a, unsigned *flags, int is_cos)
     if (!(fabs(a.lo) <= TRIG_MAX && fabs(a.hi) <= TRIG_MAX) || a.hi - a.lo >= 6.0)
         return mk(-1.0, 1.0);
     double f0 = is_cos ? cos(a.lo) : sin(a.lo), f1 = is_cos ? cos(a.hi) : sin(a.hi);
-    double lo = dn2(fmin(f0, f1)), hi = up2(fmax(f0, f1));
+    double lo = dn2(min2(f0, f1)), hi = up2(max2(f0, f1));
     double pmax = is_cos ? 0.0 : M_PI / 2, pmin = is_cos ? M_PI : -M_PI / 2;
     if (may_hit(a.lo, a.hi, pmax, 2 * M_PI))
         hi = 1.0;

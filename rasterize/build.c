@@ -29,8 +29,8 @@
 
 #define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
 #define NEWTON_STEPS 4        /* guarded Newton steps from the voxel centre onto f = 0 */
-#define NEWTON_TOL 1e-3       /* stop once a step is below this fraction of a voxel */
-#define TAYLOR_DEPTHS 2       /* the Taylor test runs on the voxels and their parents */
+#define NEWTON_TOL 0.02       /* stop once a step is below this fraction of a voxel: the
+                                 linearisation there is then far inside the offset step */
 #define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
 
 /* --- growable buffers -------------------------------------------------- */
@@ -70,6 +70,7 @@ typedef struct build_ctx {
     const build_params *par;
     unsigned levels, nsurf, task_depth;
     double origin[3], edge;
+    double cell_edge[OCT_MAX_LEVELS + 1]; /* edge / 2^depth, exact (a power-of-two scaling) */
     double bmax[3];            /* bounds' max corner: cells are clipped to it */
     const tape **full;         /* full tape of each surface */
     uint32_t *tape_off;        /* offset of each surface's prune buffer */
@@ -140,10 +141,10 @@ static void worker_free(worker *wk)
 static int cell_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], interval box[3],
                     double centre[3])
 {
-    double h = ldexp(c->edge, -(int)depth); /* exact: a power-of-two scaling */
+    double h = c->cell_edge[depth];
     for (int k = 0; k < 3; k++) {
-        double lo = nextafter(c->origin[k] + (double)cell[k] * h, -INFINITY);
-        double hi = nextafter(c->origin[k] + (double)(cell[k] + 1) * h, INFINITY);
+        double lo = interval_down(c->origin[k] + (double)cell[k] * h);
+        double hi = interval_up(c->origin[k] + (double)(cell[k] + 1) * h);
         if (hi > c->bmax[k])
             hi = c->bmax[k];
         if (lo > hi)
@@ -155,46 +156,90 @@ static int cell_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], 
     return 1;
 }
 
-/* Enclosure of f(centre) + grad f(box) . (box - centre): the mean-value
- * form. Returns 1 when it proves f != 0 on the box. */
-static int taylor_excludes_zero(worker *wk, const tape *t, const interval box[3],
-                                const double centre[3], int lipschitz)
+/* f over the degenerate box [c, c]: a sound enclosure of f(c). */
+static int eval_at_centre(worker *wk, const tape *t, const double centre[3], interval *fc)
 {
-    interval g[3];
-    unsigned fl = 0;
-    tape_eval_interval_grad(t, box, g, wk->islots, &fl);
-    wk->st.gradient_evals++;
-    if (fl)
-        return 0;
     interval cb[3];
     for (int k = 0; k < 3; k++)
         cb[k].lo = cb[k].hi = centre[k];
-    unsigned fc_fl = 0;
-    interval fc = tape_eval_interval(t, cb, wk->slots2, &fc_fl);
-    if (fc_fl || interval_is_nan(fc))
-        return 0;
-    if (lipschitz) { /* Kalra-Barr: |f(p) - f(c)| <= sum_k sup|df/dk| * r_k */
-        double bound = 0.0;
-        for (int k = 0; k < 3; k++) {
-            double gk = fmax(fabs(g[k].lo), fabs(g[k].hi));
-            double rk = fmax(centre[k] - box[k].lo, box[k].hi - centre[k]);
-            bound += gk * rk;
-        }
-        if (!isfinite(bound))
-            return 0;
-        bound = bound * (1.0 + 0x1p-40) + 0x1p-1000; /* cover the rounding of the sum */
-        return fc.lo > bound || fc.hi < -bound;
-    }
-    unsigned sfl = 0;
+    unsigned fl = 0;
+    *fc = tape_eval_interval(t, cb, wk->slots2, &fl);
+    wk->st.interval_evals++;
+    return !fl && !interval_is_nan(*fc);
+}
+
+/* 1 when fc + G . (box - c), the mean-value form (fc encloses f(c), G the
+ * gradient over a convex set holding c and box), proves f != 0 on box. */
+static int mean_value_excludes_zero(interval fc, const interval G[3], const interval box[3],
+                                    const double c[3])
+{
+    unsigned fl = 0;
     interval sum = fc;
     for (int k = 0; k < 3; k++) {
-        interval r = {nextafter(box[k].lo - centre[k], -INFINITY),
-                      nextafter(box[k].hi - centre[k], INFINITY)};
-        sum = interval_add(sum, interval_mul(g[k], r, &sfl), &sfl);
+        interval r = {interval_down(box[k].lo - c[k]), interval_up(box[k].hi - c[k])};
+        sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
     }
-    if (sfl || interval_is_nan(sum))
+    return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
+}
+
+/* Kalra-Barr: |f(p) - f(c)| <= sum_k sup|df/dk| * r_k over the box. 1 when
+ * |f(c)| exceeds that bound. */
+static int lipschitz_excludes_zero(worker *wk, const tape *t, const interval box[3],
+                                   const double centre[3])
+{
+    interval g[3], fc;
+    unsigned fl = 0;
+    tape_eval_interval_grad(t, box, g, wk->islots, &fl);
+    wk->st.gradient_evals++;
+    if (fl || !eval_at_centre(wk, t, centre, &fc))
         return 0;
-    return sum.lo > 0.0 || sum.hi < 0.0;
+    double bound = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double gk = fmax(fabs(g[k].lo), fabs(g[k].hi));
+        double rk = fmax(centre[k] - box[k].lo, box[k].hi - centre[k]);
+        bound += gk * rk;
+    }
+    if (!isfinite(bound))
+        return 0;
+    bound = bound * (1.0 + 0x1p-40) + 0x1p-1000; /* cover the rounding of the sum */
+    return fc.lo > bound || fc.hi < -bound;
+}
+
+/* The plain test of one surface on one cell: 0 when the cell provably holds
+ * no point of it. Leaves the slot enclosures in wk->slots for pruning and
+ * sets *flags. */
+static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
+                             const interval box[3], const double centre[3], unsigned *flags)
+{
+    const build_ctx *c = wk->c;
+    *flags = 0;
+    interval v = tape_eval_interval(t, box, wk->slots, flags);
+    wk->st.interval_evals++;
+    wk->st.insns_evaluated += t->n;
+    wk->st.insns_full += c->full[s]->n;
+    if (interval_is_nan(v)) { /* defined nowhere in the cell: no surface point */
+        wk->st.nan_cells++;
+        return 0;
+    }
+    if (*flags) {
+        wk->st.nan_cells++;
+        return v.lo <= 0.0 && v.hi >= 0.0;
+    }
+    if (v.lo > 0.0 || v.hi < 0.0)
+        return 0;
+    if (c->par->method == BUILD_LIPSCHITZ && lipschitz_excludes_zero(wk, t, box, centre)) {
+        if (depth == c->levels)
+            wk->st.taylor_drops++;
+        return 0;
+    }
+    return 1;
+}
+
+static int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
+                          const interval box[3], const double centre[3])
+{
+    unsigned flags;
+    return surface_may_cross(wk, t, s, depth, box, centre, &flags);
 }
 
 /* Tests the cell (depth, cell) for every surface that may cross its parent
@@ -209,29 +254,12 @@ static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint6
     if (!cell_box(c, depth, cell, box, centre))
         return 0;
     unsigned idx = depth + 1, n = 0, ns = c->nsurf;
-    int lipschitz = c->par->method == BUILD_LIPSCHITZ;
     for (unsigned k = 0; k < wk->nact[pidx]; k++) {
         unsigned s = wk->act[(size_t)pidx * ns + k];
         const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-        unsigned flags = 0;
-        interval v = tape_eval_interval(t, box, wk->slots, &flags);
-        wk->st.interval_evals++;
-        wk->st.insns_evaluated += t->n;
-        wk->st.insns_full += c->full[s]->n;
-        if (interval_is_nan(v)) { /* defined nowhere in the cell: no surface point */
-            wk->st.nan_cells++;
+        unsigned flags;
+        if (!surface_may_cross(wk, t, s, depth, box, centre, &flags))
             continue;
-        }
-        if (flags)
-            wk->st.nan_cells++;
-        if (v.lo > 0.0 || v.hi < 0.0)
-            continue;
-        if (!flags && (lipschitz || depth + TAYLOR_DEPTHS > c->levels) &&
-            taylor_excludes_zero(wk, t, box, centre, lipschitz)) {
-            if (depth == c->levels)
-                wk->st.taylor_drops++;
-            continue;
-        }
         wk->act[(size_t)idx * ns + n++] = (uint8_t)s;
         tape *child = &wk->tapes[(size_t)idx * ns + s];
         if (depth < c->levels && c->has_minmax[s]) {
@@ -259,23 +287,21 @@ static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], c
                              double h)
 {
     double p[3] = {centre[0], centre[1], centre[2]}, g[3], f = 0.0;
-    for (int step = 0; step < NEWTON_STEPS; step++) {
+    for (int step = 0;; step++) {
         f = tape_eval_grad(t, p, g, wk->dslots);
         wk->st.point_evals++;
         double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
+        if (step == NEWTON_STEPS || !(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
             break;
-        double moved = 0.0;
+        double q[3], moved = 0.0;
         for (int k = 0; k < 3; k++) {
-            double q = fmin(fmax(p[k] - f / g2 * g[k], box[k].lo), box[k].hi);
-            moved = fmax(moved, fabs(q - p[k]));
-            p[k] = q;
+            q[k] = fmin(fmax(p[k] - f / g2 * g[k], box[k].lo), box[k].hi);
+            moved = fmax(moved, fabs(q[k] - p[k]));
         }
         if (moved < NEWTON_TOL * h)
-            break; /* f and g at p are within the tolerance of the last ones */
+            break; /* the linearisation at p below places the surface well enough */
+        memcpy(p, q, sizeof p);
     }
-    f = tape_eval_grad(t, p, g, wk->dslots);
-    wk->st.point_evals++;
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g) || !isfinite(f)) {
         memcpy(p, centre, sizeof p);
@@ -330,7 +356,7 @@ static int emit_voxel(worker *wk, const uint64_t cell[3])
         }
     }
     uint32_t rec = voxel_record(wk, &wk->tapes[(size_t)idx * ns + best], box, centre,
-                                ldexp(c->edge, -(int)c->levels));
+                                c->cell_edge[c->levels]);
     uint8_t surf = (uint8_t)best;
     if (buf_push(&wk->out->voxels, &rec, sizeof rec) ||
         (ns > 1 && buf_push(&wk->out->surfaces, &surf, 1))) {
@@ -341,18 +367,76 @@ static int emit_voxel(worker *wk, const uint64_t cell[3])
     return 1;
 }
 
+/* Tests the voxels of a leaf-parent node (depth levels - 1) and emits those
+ * that survive. With c the node's centre and G an enclosure of the gradient
+ * over the node, a voxel is dropped when f([c]) + G . (voxel - c) excludes 0:
+ * the mean-value form, sound because every voxel lies inside the node. That
+ * is one interval-gradient and one point-interval evaluation per node, and a
+ * three-term dot product per voxel, where the plain test needs a tape
+ * evaluation per voxel; and at this scale the form is the tighter of the
+ * two (its excess width shrinks with the square of the cell size). Where the
+ * gradient may be undefined (flags), the plain interval test is used. */
+static uint8_t visit_leaf_parent(worker *wk, unsigned depth, const uint64_t cell[3])
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1, vidx = depth + 2;
+    int lipschitz = c->par->method == BUILD_LIPSCHITZ;
+    interval pbox[3], G[OCT_MAX_SURFACES][3], fc[OCT_MAX_SURFACES];
+    double pc[3];
+    uint8_t plain[OCT_MAX_SURFACES], mask = 0;
+    cell_box(c, depth, cell, pbox, pc);
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k], fl = 0;
+        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+        plain[k] = 1;
+        if (lipschitz)
+            continue;
+        tape_eval_interval_grad(t, pbox, G[k], wk->islots, &fl);
+        wk->st.gradient_evals++;
+        plain[k] = fl != 0 || !eval_at_centre(wk, t, pc, &fc[k]);
+    }
+    for (unsigned i = 0; i < 8 && !wk->failed; i++) {
+        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
+        interval box[3];
+        double centre[3];
+        if (!cell_box(c, depth + 1, cc, box, centre))
+            continue;
+        unsigned n = 0;
+        for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+            unsigned s = wk->act[(size_t)pidx * ns + k];
+            const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+            if (plain[k]) {
+                if (!cell_may_cross(wk, t, s, depth + 1, box, centre))
+                    continue;
+            } else if (mean_value_excludes_zero(fc[k], G[k], box, pc)) {
+                wk->st.taylor_drops++;
+                continue;
+            }
+            wk->act[(size_t)vidx * ns + n++] = (uint8_t)s;
+            wk->tapes[(size_t)vidx * ns + s] = *t;
+        }
+        wk->nact[vidx] = n;
+        if (n && emit_voxel(wk, cc))
+            mask |= (uint8_t)(1u << i);
+    }
+    return mask;
+}
+
 /* Builds the subtree of a cell already tested non-empty; returns its child
  * mask (0 when nothing below it survived). */
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
 {
     const unsigned levels = wk->c->levels;
     uint8_t mask = 0;
-    for (unsigned i = 0; i < 8 && !wk->failed; i++) {
-        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
-        if (!test_cell(wk, depth + 1, depth + 1, cc))
-            continue;
-        if (depth + 1 == levels ? emit_voxel(wk, cc) : visit_node(wk, depth + 1, cc))
-            mask |= (uint8_t)(1u << i);
+    if (depth + 1 == levels) {
+        mask = visit_leaf_parent(wk, depth, cell);
+    } else {
+        for (unsigned i = 0; i < 8 && !wk->failed; i++) {
+            uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1),
+                              2 * cell[2] + (i >> 2)};
+            if (test_cell(wk, depth + 1, depth + 1, cc) && visit_node(wk, depth + 1, cc))
+                mask |= (uint8_t)(1u << i);
+        }
     }
     if (mask) {
         if (buf_push(&wk->out->masks[depth], &mask, 1)) {
@@ -500,6 +584,8 @@ oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, buil
     build_cube(sc, c.origin, &c.edge);
     for (int k = 0; k < 3; k++)
         c.bmax[k] = sc->hi[k];
+    for (unsigned d = 0; d <= c.levels; d++)
+        c.cell_edge[d] = ldexp(c.edge, -(int)d);
 
     oct_err err = OCT_ENOMEM;
     pool pl;

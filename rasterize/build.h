@@ -33,7 +33,7 @@ typedef struct build_stats {
     uint64_t point_evals;        /* point/gradient evaluations for normals */
     uint64_t insns_evaluated;    /* tape instructions run by the interval evaluations */
     uint64_t insns_full;         /* what they would have been without pruning */
-    uint64_t taylor_drops;       /* voxels the interval kept and the Taylor form dropped */
+    uint64_t taylor_drops;       /* candidate voxels the mean-value (Taylor) form dropped */
     uint64_t nan_cells;          /* cells where f may be undefined (kept, subdivided) */
     uint64_t normal_fallbacks;   /* voxels whose gradient was zero or not finite */
 } build_stats;
