@@ -9,6 +9,8 @@ static double dn(double x) { return nextafter(x, -INFINITY); }
 static double up(double x) { return nextafter(x, INFINITY); }
 static double dn2(double x) { return dn(dn(x)); }
 static double up2(double x) { return up(up(x)); }
+static int has_zero(interval a) { return a.lo <= 0.0 && a.hi >= 0.0; }
+static int has_inf(interval a) { return isinf(a.lo) || isinf(a.hi); }
 static int isnan_iv(interval a) { return a.lo != a.lo || a.hi != a.hi; }
 static interval mk(double lo, double hi) { interval r = {lo, hi}; return r; }
 static interval nan_iv(unsigned *flags)
@@ -35,6 +37,10 @@ interval interval_add(interval a, interval b, unsigned *flags)
 {
     if (isnan_iv(a) || isnan_iv(b))
         return nan_iv(flags);
+    /* Infinite ends are points of the box (an overflowed value), so
+     * -inf + inf may happen inside even when no corner shows it. */
+    if ((a.lo == -INFINITY && b.hi == INFINITY) || (a.hi == INFINITY && b.lo == -INFINITY))
+        *flags |= INTERVAL_MAYBE_NAN;
     double lo = a.lo + b.lo, hi = a.hi + b.hi;
     if (lo != lo) { /* -inf + inf: an operand is infinite at some point */
         lo = -INFINITY;
@@ -69,7 +75,7 @@ interval interval_mul(interval a, interval b, unsigned *flags)
 {
     if (isnan_iv(a) || isnan_iv(b))
         return nan_iv(flags);
-    int bad = 0;
+    int bad = (has_zero(a) && has_inf(b)) || (has_zero(b) && has_inf(a)); /* 0*inf inside */
     double p1 = mul0(a.lo, b.lo, &bad), p2 = mul0(a.lo, b.hi, &bad);
     double p3 = mul0(a.hi, b.lo, &bad), p4 = mul0(a.hi, b.hi, &bad);
     double lo = fmin(fmin(p1, p2), fmin(p3, p4));
@@ -83,6 +89,8 @@ interval interval_div(interval a, interval b, unsigned *flags)
 {
     if (isnan_iv(a) || isnan_iv(b))
         return nan_iv(flags);
+    if (has_inf(a) && has_inf(b))
+        *flags |= INTERVAL_MAYBE_NAN; /* inf/inf */
     if (b.lo <= 0.0 && b.hi >= 0.0) {
         /* Either sign of infinity is reachable (a signed zero is not
          * visible to comparisons), so give up on half-infinite bounds. */
@@ -174,17 +182,19 @@ interval interval_max(interval a, interval b)
     return mk(a.lo > b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
 }
 
-/* Beyond this magnitude trigonometric functions get their full range:
- * below it, (x - phase) / period is known to about 1e-8. */
+/* Beyond this magnitude trigonometric functions get their full range. */
 #define TRIG_MAX 1e8
-#define TRIG_EPS 1e-6
 
-/* May [lo, hi] contain phase + k*period for an integer k? Errs towards yes:
- * the quotients carry a few 1e-9 of error for |x| <= TRIG_MAX. */
+/* May [lo, hi] contain phase + k*period for an integer k? Errs towards yes.
+ * k = (x - phase) / period in double carries an absolute error below
+ * ~2.2e-16 * (|x| + 2) / period (the subtraction) plus ~4.4e-16 * |k|
+ * (phase, period and the division), i.e. below 1e-15 * (|x| + 4) for
+ * period >= pi; eps takes that over both ends. */
 static int may_hit(double lo, double hi, double phase, double period)
 {
     double kl = (lo - phase) / period, kh = (hi - phase) / period;
-    return floor(kh + TRIG_EPS) >= ceil(kl - TRIG_EPS);
+    double eps = 1e-15 * (fabs(lo) + fabs(hi) + 4.0);
+    return floor(kh + eps) >= ceil(kl - eps);
 }
 
 static interval clamp11(double lo, double hi)
@@ -237,6 +247,12 @@ interval interval_powc(interval a, double p, unsigned *flags)
     }
     double r0 = pow(lo, p), r1 = pow(a.hi, p);
     double l = dn2(p > 0 ? r0 : r1), h = up2(p > 0 ? r1 : r0);
+    if (a.lo == -INFINITY) { /* pow(-inf, p) is +0 for p < 0, +inf for p > 0 */
+        if (p > 0)
+            h = INFINITY;
+        else
+            l = 0.0;
+    }
     if (p == 0.0) { l = 1.0; h = 1.0; }
     return mk(l < 0.0 ? 0.0 : l, h);
 }
