@@ -3,10 +3,27 @@
 #include "common/interval.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 
-static double dn(double x) { return nextafter(x, -INFINITY); }
-static double up(double x) { return nextafter(x, INFINITY); }
+/* nextafter(x, +inf) without the libm call (it is the hot spot of every
+ * interval operation): step the bit pattern. NaN and +inf stay. */
+static inline double up(double x)
+{
+    if (x != x || x == INFINITY)
+        return x;
+    if (x == 0.0)
+        return 0x1p-1074;
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u = x > 0.0 ? u + 1 : u - 1;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+static inline double dn(double x) { return -up(-x); }
+static inline double min2(double a, double b) { return a < b ? a : b; } /* no NaN here */
+static inline double max2(double a, double b) { return a > b ? a : b; }
 static double dn2(double x) { return dn(dn(x)); }
 static double up2(double x) { return up(up(x)); }
 static int has_zero(interval a) { return a.lo <= 0.0 && a.hi >= 0.0; }
@@ -78,8 +95,8 @@ interval interval_mul(interval a, interval b, unsigned *flags)
     int bad = (has_zero(a) && has_inf(b)) || (has_zero(b) && has_inf(a)); /* 0*inf inside */
     double p1 = mul0(a.lo, b.lo, &bad), p2 = mul0(a.lo, b.hi, &bad);
     double p3 = mul0(a.hi, b.lo, &bad), p4 = mul0(a.hi, b.hi, &bad);
-    double lo = fmin(fmin(p1, p2), fmin(p3, p4));
-    double hi = fmax(fmax(p1, p2), fmax(p3, p4));
+    double lo = min2(min2(p1, p2), min2(p3, p4));
+    double hi = max2(max2(p1, p2), max2(p3, p4));
     if (bad)
         *flags |= INTERVAL_MAYBE_NAN;
     return mk(dn(lo), up(hi));
@@ -103,7 +120,7 @@ interval interval_div(interval a, interval b, unsigned *flags)
         *flags |= INTERVAL_MAYBE_NAN;
         return mk(-INFINITY, INFINITY);
     }
-    return mk(dn(fmin(fmin(q1, q2), fmin(q3, q4))), up(fmax(fmax(q1, q2), fmax(q3, q4))));
+    return mk(dn(min2(min2(q1, q2), min2(q3, q4))), up(max2(max2(q1, q2), max2(q3, q4))));
 }
 
 interval interval_sqr(interval a, unsigned *flags)
@@ -212,7 +229,7 @@ static interval sin_or_cos(interval a, unsigned *flags, int is_cos)
     if (!(fabs(a.lo) <= TRIG_MAX && fabs(a.hi) <= TRIG_MAX) || a.hi - a.lo >= 6.0)
         return mk(-1.0, 1.0);
     double f0 = is_cos ? cos(a.lo) : sin(a.lo), f1 = is_cos ? cos(a.hi) : sin(a.hi);
-    double lo = dn2(fmin(f0, f1)), hi = up2(fmax(f0, f1));
+    double lo = dn2(min2(f0, f1)), hi = up2(max2(f0, f1));
     double pmax = is_cos ? 0.0 : M_PI / 2, pmin = is_cos ? M_PI : -M_PI / 2;
     if (may_hit(a.lo, a.hi, pmax, 2 * M_PI))
         hi = 1.0;
