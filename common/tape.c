@@ -458,7 +458,8 @@ int tape_builder_finish(tape_builder *b, int32_t root, tape *out)
     mark(b->insn, b->n, r, NULL, m);
     out->n = compact(b->insn, b->n, &r, m, insn);
     out->root = r;
-    memcpy(k, b->konst, b->nconst * sizeof *k);
+    if (b->nconst)
+        memcpy(k, b->konst, b->nconst * sizeof *k);
     out->insn = insn;
     out->konst = k;
     out->nconst = b->nconst;
