@@ -13,6 +13,7 @@ struct tape_builder {
     uint32_t nconst, kcap;
     uint32_t *hash; /* open addressing over insn indices; UINT32_MAX = empty */
     uint32_t hcap;
+    uint32_t nreq; /* emit calls, for tape.ntree */
 };
 
 #define EMPTY UINT32_MAX
@@ -169,6 +170,7 @@ static int32_t add_pool(tape_builder *b, double v, double lo, double hi)
 
 int32_t tape_emit_const(tape_builder *b, double v, double lo, double hi)
 {
+    b->nreq++;
     if (!isfinite(v) || !(lo <= v && v <= hi))
         return TAPE_EDOMAIN;
     int32_t k = add_pool(b, v, lo, hi);
@@ -180,6 +182,7 @@ int32_t tape_emit_const(tape_builder *b, double v, double lo, double hi)
 
 int32_t tape_emit_var(tape_builder *b, int axis)
 {
+    b->nreq++;
     tape_insn in = {(uint32_t)(TAPE_X + axis), 0, 0};
     return intern(b, in);
 }
@@ -290,6 +293,7 @@ static int is_const(const tape_builder *b, int32_t s) { return b->insn[s].op == 
 
 int32_t tape_emit_unary(tape_builder *b, tape_op op, int32_t a)
 {
+    b->nreq++;
     if (a < 0)
         return a;
     if (is_const(b, a))
@@ -300,6 +304,7 @@ int32_t tape_emit_unary(tape_builder *b, tape_op op, int32_t a)
 
 int32_t tape_emit_binary(tape_builder *b, tape_op op, int32_t a, int32_t c)
 {
+    b->nreq++;
     if (a < 0)
         return a;
     if (c < 0)
@@ -464,6 +469,7 @@ int tape_builder_finish(tape_builder *b, int32_t root, tape *out)
     out->konst = k;
     out->nconst = b->nconst;
     out->owned = 1;
+    out->ntree = b->nreq;
     free(m);
     return TAPE_OK;
 }
