@@ -705,16 +705,33 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
             break;
         }
         case TAPE_ADD:
-            r->v = interval_add(a->v, c->v, &f);
-            for (int j = 0; j < 3; j++)
-                r->d[j] = interval_add(a->d[j], c->d[j], &f);
+        case TAPE_SUB: {
+            int add = in[i].op == TAPE_ADD;
+            interval v = add ? interval_add(a->v, c->v, &f) : interval_sub(a->v, c->v, &f);
+            /* A constant operand has a zero derivative: skip the arithmetic. */
+            if (in[in[i].b].op == TAPE_CONST) {
+                for (int j = 0; j < 3; j++)
+                    r->d[j] = a->d[j];
+            } else if (in[in[i].a].op == TAPE_CONST) {
+                for (int j = 0; j < 3; j++)
+                    r->d[j] = add ? c->d[j] : interval_neg(c->d[j]);
+            } else {
+                for (int j = 0; j < 3; j++)
+                    r->d[j] = add ? interval_add(a->d[j], c->d[j], &f)
+                                  : interval_sub(a->d[j], c->d[j], &f);
+            }
+            r->v = v;
             break;
-        case TAPE_SUB:
-            r->v = interval_sub(a->v, c->v, &f);
-            for (int j = 0; j < 3; j++)
-                r->d[j] = interval_sub(a->d[j], c->d[j], &f);
-            break;
+        }
         case TAPE_MUL:
+            if (in[in[i].a].op == TAPE_CONST) {
+                iscale(r, c, interval_mul(a->v, c->v, &f), a->v, &f);
+                break;
+            }
+            if (in[in[i].b].op == TAPE_CONST) {
+                iscale(r, a, interval_mul(a->v, c->v, &f), c->v, &f);
+                break;
+            }
             for (int j = 0; j < 3; j++)
                 r->d[j] = interval_add(interval_mul(a->d[j], c->v, &f),
                                        interval_mul(a->v, c->d[j], &f), &f);
