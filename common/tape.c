@@ -278,13 +278,17 @@ static int32_t fold(tape_builder *b, tape_op op, int32_t a, int32_t c, double p)
         int exact = 0;
         if (op == TAPE_ADD) exact = two_sum_err(x, y, v) == 0.0;
         else if (op == TAPE_SUB) exact = two_sum_err(x, -y, v) == 0.0;
-        else if (op == TAPE_MUL) exact = fma(x, y, -v) == 0.0 && (v != 0.0 || x == 0.0 || y == 0.0);
-        else if (op == TAPE_DIV) exact = y != 0.0 && fma(v, y, -x) == 0.0 && (v != 0.0 || x == 0.0);
+        /* fma gives the exact residual unless it underflows: stay clear of
+         * the subnormal range. */
+        else if (op == TAPE_MUL)
+            exact = (x == 0.0 || y == 0.0) || (fabs(v) >= 0x1p-900 && fma(x, y, -v) == 0.0);
+        else if (op == TAPE_DIV)
+            exact = x == 0.0 || (fabs(v) >= 0x1p-900 && fabs(x) >= 0x1p-900 && fma(v, y, -x) == 0.0);
         if (exact)
             r.lo = r.hi = v;
     }
-    if (op == TAPE_SQUARE && ka->lo == ka->hi && fma(ka->v, ka->v, -v) == 0.0 &&
-        (v != 0.0 || ka->v == 0.0))
+    if (op == TAPE_SQUARE && ka->lo == ka->hi &&
+        (ka->v == 0.0 || (fabs(v) >= 0x1p-900 && fma(ka->v, ka->v, -v) == 0.0)))
         r.lo = r.hi = v;
     return tape_emit_const(b, v, r.lo, r.hi);
 }
