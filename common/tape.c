@@ -527,6 +527,15 @@ double tape_eval(const tape *t, double x, double y, double z, double *s)
     return s[t->root];
 }
 
+/* Operand slots of an instruction, 0 where the field is not a slot (a
+ * constant-pool index, or unused), so that no pointer is formed outside
+ * the caller's slot array. */
+static inline uint32_t slot_a(const tape_insn *in) { return in->op > TAPE_Z ? in->a : 0; }
+static inline uint32_t slot_b(const tape_insn *in)
+{
+    return in->op >= TAPE_ADD && in->op != TAPE_POWC ? in->b : 0;
+}
+
 /* r = a * scale, on the three partials. */
 static void dscale(tape_dual *r, const tape_dual *a, double v, double scale)
 {
@@ -541,7 +550,7 @@ double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dua
     const tape_const *k = t->konst;
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_dual *r = &s[i];
-        const tape_dual *a = &s[in[i].a], *c = &s[in[i].b];
+        const tape_dual *a = s + slot_a(&in[i]), *c = s + slot_b(&in[i]);
         switch ((tape_op)in[i].op) {
         case TAPE_CONST:
             r->v = k[in[i].a].v;
@@ -662,7 +671,7 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
     unsigned f = 0;
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_idual *r = &s[i];
-        const tape_idual *a = &s[in[i].a], *c = &s[in[i].b];
+        const tape_idual *a = s + slot_a(&in[i]), *c = s + slot_b(&in[i]);
         switch ((tape_op)in[i].op) {
         case TAPE_CONST:
             r->v.lo = k[in[i].a].lo;
