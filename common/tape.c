@@ -13,6 +13,7 @@ struct tape_builder {
     uint32_t nconst, kcap;
     uint32_t *hash; /* open addressing over insn indices; UINT32_MAX = empty */
     uint32_t hcap;
+    uint32_t nreq; /* emit calls, for tape.ntree */
 };
 
 #define EMPTY UINT32_MAX
@@ -169,6 +170,7 @@ static int32_t add_pool(tape_builder *b, double v, double lo, double hi)
 
 int32_t tape_emit_const(tape_builder *b, double v, double lo, double hi)
 {
+    b->nreq++;
     if (!isfinite(v) || !(lo <= v && v <= hi))
         return TAPE_EDOMAIN;
     int32_t k = add_pool(b, v, lo, hi);
@@ -180,6 +182,7 @@ int32_t tape_emit_const(tape_builder *b, double v, double lo, double hi)
 
 int32_t tape_emit_var(tape_builder *b, int axis)
 {
+    b->nreq++;
     tape_insn in = {(uint32_t)(TAPE_X + axis), 0, 0};
     return intern(b, in);
 }
@@ -275,13 +278,17 @@ static int32_t fold(tape_builder *b, tape_op op, int32_t a, int32_t c, double p)
         int exact = 0;
         if (op == TAPE_ADD) exact = two_sum_err(x, y, v) == 0.0;
         else if (op == TAPE_SUB) exact = two_sum_err(x, -y, v) == 0.0;
-        else if (op == TAPE_MUL) exact = fma(x, y, -v) == 0.0 && (v != 0.0 || x == 0.0 || y == 0.0);
-        else if (op == TAPE_DIV) exact = y != 0.0 && fma(v, y, -x) == 0.0 && (v != 0.0 || x == 0.0);
+        /* fma gives the exact residual unless it underflows: stay clear of
+         * the subnormal range. */
+        else if (op == TAPE_MUL)
+            exact = (x == 0.0 || y == 0.0) || (fabs(v) >= 0x1p-900 && fma(x, y, -v) == 0.0);
+        else if (op == TAPE_DIV)
+            exact = x == 0.0 || (fabs(v) >= 0x1p-900 && fabs(x) >= 0x1p-900 && fma(v, y, -x) == 0.0);
         if (exact)
             r.lo = r.hi = v;
     }
-    if (op == TAPE_SQUARE && ka->lo == ka->hi && fma(ka->v, ka->v, -v) == 0.0 &&
-        (v != 0.0 || ka->v == 0.0))
+    if (op == TAPE_SQUARE && ka->lo == ka->hi &&
+        (ka->v == 0.0 || (fabs(v) >= 0x1p-900 && fma(ka->v, ka->v, -v) == 0.0)))
         r.lo = r.hi = v;
     return tape_emit_const(b, v, r.lo, r.hi);
 }
@@ -290,6 +297,7 @@ static int is_const(const tape_builder *b, int32_t s) { return b->insn[s].op == 
 
 int32_t tape_emit_unary(tape_builder *b, tape_op op, int32_t a)
 {
+    b->nreq++;
     if (a < 0)
         return a;
     if (is_const(b, a))
@@ -300,6 +308,7 @@ int32_t tape_emit_unary(tape_builder *b, tape_op op, int32_t a)
 
 int32_t tape_emit_binary(tape_builder *b, tape_op op, int32_t a, int32_t c)
 {
+    b->nreq++;
     if (a < 0)
         return a;
     if (c < 0)
@@ -458,11 +467,13 @@ int tape_builder_finish(tape_builder *b, int32_t root, tape *out)
     mark(b->insn, b->n, r, NULL, m);
     out->n = compact(b->insn, b->n, &r, m, insn);
     out->root = r;
-    memcpy(k, b->konst, b->nconst * sizeof *k);
+    if (b->nconst)
+        memcpy(k, b->konst, b->nconst * sizeof *k);
     out->insn = insn;
     out->konst = k;
     out->nconst = b->nconst;
     out->owned = 1;
+    out->ntree = b->nreq;
     free(m);
     return TAPE_OK;
 }
@@ -516,6 +527,15 @@ double tape_eval(const tape *t, double x, double y, double z, double *s)
     return s[t->root];
 }
 
+/* Operand slots of an instruction, 0 where the field is not a slot (a
+ * constant-pool index, or unused), so that no pointer is formed outside
+ * the caller's slot array. */
+static inline uint32_t slot_a(const tape_insn *in) { return in->op > TAPE_Z ? in->a : 0; }
+static inline uint32_t slot_b(const tape_insn *in)
+{
+    return in->op >= TAPE_ADD && in->op != TAPE_POWC ? in->b : 0;
+}
+
 /* r = a * scale, on the three partials. */
 static void dscale(tape_dual *r, const tape_dual *a, double v, double scale)
 {
@@ -530,7 +550,7 @@ double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dua
     const tape_const *k = t->konst;
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_dual *r = &s[i];
-        const tape_dual *a = &s[in[i].a], *c = &s[in[i].b];
+        const tape_dual *a = s + slot_a(&in[i]), *c = s + slot_b(&in[i]);
         switch ((tape_op)in[i].op) {
         case TAPE_CONST:
             r->v = k[in[i].a].v;
@@ -651,7 +671,7 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
     unsigned f = 0;
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_idual *r = &s[i];
-        const tape_idual *a = &s[in[i].a], *c = &s[in[i].b];
+        const tape_idual *a = s + slot_a(&in[i]), *c = s + slot_b(&in[i]);
         switch ((tape_op)in[i].op) {
         case TAPE_CONST:
             r->v.lo = k[in[i].a].lo;
@@ -698,16 +718,33 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
             break;
         }
         case TAPE_ADD:
-            r->v = interval_add(a->v, c->v, &f);
-            for (int j = 0; j < 3; j++)
-                r->d[j] = interval_add(a->d[j], c->d[j], &f);
+        case TAPE_SUB: {
+            int add = in[i].op == TAPE_ADD;
+            interval v = add ? interval_add(a->v, c->v, &f) : interval_sub(a->v, c->v, &f);
+            /* A constant operand has a zero derivative: skip the arithmetic. */
+            if (in[in[i].b].op == TAPE_CONST) {
+                for (int j = 0; j < 3; j++)
+                    r->d[j] = a->d[j];
+            } else if (in[in[i].a].op == TAPE_CONST) {
+                for (int j = 0; j < 3; j++)
+                    r->d[j] = add ? c->d[j] : interval_neg(c->d[j]);
+            } else {
+                for (int j = 0; j < 3; j++)
+                    r->d[j] = add ? interval_add(a->d[j], c->d[j], &f)
+                                  : interval_sub(a->d[j], c->d[j], &f);
+            }
+            r->v = v;
             break;
-        case TAPE_SUB:
-            r->v = interval_sub(a->v, c->v, &f);
-            for (int j = 0; j < 3; j++)
-                r->d[j] = interval_sub(a->d[j], c->d[j], &f);
-            break;
+        }
         case TAPE_MUL:
+            if (in[in[i].a].op == TAPE_CONST) {
+                iscale(r, c, interval_mul(a->v, c->v, &f), a->v, &f);
+                break;
+            }
+            if (in[in[i].b].op == TAPE_CONST) {
+                iscale(r, a, interval_mul(a->v, c->v, &f), c->v, &f);
+                break;
+            }
             for (int j = 0; j < 3; j++)
                 r->d[j] = interval_add(interval_mul(a->d[j], c->v, &f),
                                        interval_mul(a->v, c->d[j], &f), &f);

@@ -40,6 +40,8 @@ typedef struct tape {
     const tape_const *konst;
     uint32_t nconst;
     int owned; /* insn and konst were allocated by tape_builder_finish */
+    uint32_t ntree; /* instructions requested while building, before sharing,
+                       folding and dead-code removal (for statistics) */
 } tape;
 
 /* Forward-mode dual numbers for the gradient evaluators. */

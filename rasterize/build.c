@@ -143,8 +143,8 @@ static int cell_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], 
 {
     double h = c->cell_edge[depth];
     for (int k = 0; k < 3; k++) {
-        double lo = interval_down(c->origin[k] + (double)cell[k] * h);
-        double hi = interval_up(c->origin[k] + (double)(cell[k] + 1) * h);
+        double lo = interval_next_down(c->origin[k] + (double)cell[k] * h);
+        double hi = interval_next_up(c->origin[k] + (double)(cell[k] + 1) * h);
         if (hi > c->bmax[k])
             hi = c->bmax[k];
         if (lo > hi)
@@ -176,7 +176,7 @@ static int mean_value_excludes_zero(interval fc, const interval G[3], const inte
     unsigned fl = 0;
     interval sum = fc;
     for (int k = 0; k < 3; k++) {
-        interval r = {interval_down(box[k].lo - c[k]), interval_up(box[k].hi - c[k])};
+        interval r = {interval_next_down(box[k].lo - c[k]), interval_next_up(box[k].hi - c[k])};
         sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
     }
     return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);

@@ -164,6 +164,28 @@ static void test_constant_intervals(void **state)
         if (t->konst[i].v == 154.5)
             assert_true(t->konst[i].lo == t->konst[i].hi); /* exact literals stay exact */
     scene_free(s);
+    /* Folded constants: exact when the double operation is, else an
+     * enclosure of the real value. */
+    static const struct { const char *e; double v; int exact; } fold[] = {
+        {"0.25*4", 1.0, 1}, {"1/4", 0.25, 1}, {"1.5^2", 2.25, 1}, {"3-0.5", 2.5, 1},
+        {"1/3", 1.0 / 3.0, 0}, {"0.1*3", 0.1 * 3, 0}, {"2*pi", 2 * M_PI, 0}, {"sqrt(2)", M_SQRT2, 0},
+        {"1e-200*1e-200", 1e-200 * 1e-200, 0}, {"-0.5", -0.5, 1},
+    };
+    for (size_t i = 0; i < sizeof fold / sizeof fold[0]; i++) {
+        char buf[128];
+        snprintf(buf, sizeof buf, B "surface x + (%s)\n", fold[i].e);
+        s = parse_ok(buf);
+        t = &s->surfaces[0].tape;
+        if (t->n != 3) /* x, the constant, add */
+            fail_msg("%s: %u instructions", fold[i].e, t->n);
+        const tape_const *k = &t->konst[t->insn[0].op == TAPE_CONST ? t->insn[0].a : t->insn[1].a];
+        assert_true(k->v == fold[i].v);
+        if (fold[i].exact)
+            assert_true(k->lo == k->v && k->hi == k->v);
+        else
+            assert_true(k->lo < k->v && k->v < k->hi);
+        scene_free(s);
+    }
 }
 
 static void test_expression_errors(void **state)
