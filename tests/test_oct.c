@@ -1001,7 +1001,7 @@ static void test_atomic_write_fault_loop(void **state)
 }
 
 /* Writes the fuzz seed corpus when OCT_CORPUS_DIR is set (see
- * tests/fuzz/corpus/README). */
+ * tests/fuzz/README.md). */
 static void test_make_fuzz_corpus(void **state)
 {
     (void)state;
@@ -1023,6 +1023,20 @@ static void test_make_fuzz_corpus(void **state)
                 if (corrupt) /* a bad base, CRCs fixed: reaches the tree check */
                     wr_u64le(buf + rd_u64le(buf + OCT_SEC_OFF(OCT_SEC_NODES)), 5), test_oct_refresh_crcs(buf, len);
                 FILE *f = fopen(path, "wb");
+                assert_non_null(f);
+                assert_int_equal(fwrite(buf, 1, len, f), len);
+                assert_int_equal(fclose(f), 0);
+            }
+            if (levels == 4 && variant == 2) { /* a truncated file and a bad checksum */
+                char path[512];
+                snprintf(path, sizeof path, "%s/bad-trunc-l4.oct", dir);
+                FILE *f = fopen(path, "wb");
+                assert_non_null(f);
+                assert_int_equal(fwrite(buf, 1, len / 2, f), len / 2);
+                assert_int_equal(fclose(f), 0);
+                buf[len - 1] ^= 0x10; /* a palette bit */
+                snprintf(path, sizeof path, "%s/bad-crc-l4.oct", dir);
+                f = fopen(path, "wb");
                 assert_non_null(f);
                 assert_int_equal(fwrite(buf, 1, len, f), len);
                 assert_int_equal(fclose(f), 0);
