@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include <errno.h>
+#include <signal.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -235,8 +236,121 @@ static void test_deepest_tree(void **state)
     assert_int_equal(oct_open_memory(buf, len, 0, &f, NULL), OCT_OK);
     compare(f, &t);
     oct_close(f);
+    /* A would-be DAG: one group of the deepest depth reuses an earlier
+     * group's children. Refused by the flat scan, CRCs fixed or not. */
+    uint64_t nodes = rd_u64le(buf + OCT_SEC_OFF(OCT_SEC_NODES)), g = 0;
+    for (uint32_t d = 0; d + 1 < OCT_MAX_LEVELS; d++)
+        g += t.count[d] / 8 + (t.count[d] % 8 != 0);
+    assert_true(t.count[OCT_MAX_LEVELS - 1] > 8);
+    wr_u64le(buf + nodes + 16 * (g + 1), 0);
+    uint64_t at;
+    assert_int_equal(open_buf(buf, len, OCT_OPEN_TRUST, &at), OCT_ETREE);
+    assert_int_equal(at, nodes + 16 * (g + 1));
+    test_oct_refresh_crcs(buf, len);
+    assert_int_equal(open_buf(buf, len, 0, NULL), OCT_ETREE);
     free(buf);
     test_tree_free(&t);
+}
+
+/* A subtree at the deepest root_depth, at the far corner of its grid. */
+static void test_subtree_at_depth_40(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 8, 500, 1, 8, 1);
+    t.root_depth = 40;
+    uint64_t last = (UINT64_C(1) << 40) - 1;
+    t.root_cell[0] = last; t.root_cell[1] = 0; t.root_cell[2] = last / 3;
+    t.edge = 0x1p-40;
+    for (int i = 0; i < 3; i++)
+        t.origin[i] = (double)t.root_cell[i] * t.edge; /* the grid is the unit cube at 0 */
+    unsigned char *buf;
+    size_t len;
+    assert_int_equal(test_tree_write(&t, &buf, &len), OCT_OK);
+    oct_file *f;
+    assert_int_equal(oct_open_memory(buf, len, 0, &f, NULL), OCT_OK);
+    compare(f, &t);
+    const oct_info *in = oct_get_info(f);
+    assert_true(in->grid_edge == 1.0);
+    for (int i = 0; i < 3; i++) {
+        assert_true(in->grid_origin[i] == 0.0);
+        assert_true(oct_get_tree(f)->origin[i] == t.origin[i]); /* exact: dyadic */
+        assert_int_equal(in->root_cell[i], t.root_cell[i]);
+    }
+    char *text = NULL;
+    size_t tlen = 0;
+    FILE *mf = open_memstream(&text, &tlen);
+    assert_int_equal(oct_print_info(mf, f), 0);
+    fclose(mf);
+    assert_non_null(strstr(text, "subtree:     depth 40, cell (1099511627775, 0, 366503875925)"));
+    free(text);
+    oct_close(f);
+    free(buf);
+    /* One level more and the finest voxel is too small next to the grid. */
+    t.levels = 9;
+    oct_writer_params p = {.levels = 9, .edge = t.edge, .root_depth = 40, .surface_count = 1};
+    memcpy(p.origin, t.origin, sizeof p.origin);
+    memcpy(p.root_cell, t.root_cell, sizeof p.root_cell);
+    oct_writer *w = NULL;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    t.levels = 8;
+    test_tree_free(&t);
+}
+
+/* The mapping outlives a rename over the file; a truncation in place is
+ * documented (FORMAT.md §10) to raise SIGBUS on the lost pages. */
+static void test_mapped_file_replaced_or_truncated(void **state)
+{
+    (void)state;
+    test_tree a, b;
+    test_tree_random(&a, 6, 20000, 2, 11, 0);
+    test_tree_random(&b, 3, 10, 1, 12, 0);
+    unsigned char *ba, *bb;
+    size_t la, lb;
+    assert_int_equal(test_tree_write(&a, &ba, &la), OCT_OK);
+    assert_int_equal(test_tree_write(&b, &bb, &lb), OCT_OK);
+    char dir[] = "/tmp/test_oct_map_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char pa[600], pb[600];
+    snprintf(pa, sizeof pa, "%s/a.oct", dir);
+    snprintf(pb, sizeof pb, "%s/b.oct", dir);
+    FILE *fa = fopen(pa, "wb"), *fb = fopen(pb, "wb");
+    assert_int_equal(fwrite(ba, 1, la, fa), la);
+    assert_int_equal(fwrite(bb, 1, lb, fb), lb);
+    fclose(fa);
+    fclose(fb);
+    oct_file *f;
+    assert_int_equal(oct_open(pa, 0, &f, NULL), OCT_OK);
+    assert_int_equal(rename(pb, pa), 0);
+    compare(f, &a); /* still the old inode */
+    oct_close(f);
+
+    fa = fopen(pa, "wb");
+    assert_int_equal(fwrite(ba, 1, la, fa), la);
+    fclose(fa);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        signal(SIGBUS, SIG_DFL); /* cmocka catches it otherwise */
+        if (oct_open(pa, 0, &f, NULL) != OCT_OK)
+            _exit(2);
+        if (truncate(pa, 0) != 0)
+            _exit(3);
+        const oct_tree *t = oct_get_tree(f);
+        volatile uint32_t x = t->voxels[t->voxel_count - 1]; /* on a lost page */
+        (void)x;
+        _exit(0);
+    }
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFSIGNALED(status));
+    assert_int_equal(WTERMSIG(status), SIGBUS);
+    unlink(pa);
+    rmdir(dir);
+    free(ba);
+    free(bb);
+    test_tree_free(&a);
+    test_tree_free(&b);
 }
 
 static void test_writer_is_deterministic(void **state)
@@ -1054,6 +1168,8 @@ int main(void)
         cmocka_unit_test(test_round_trip_through_file),
         cmocka_unit_test(test_empty_trees),
         cmocka_unit_test(test_deepest_tree),
+        cmocka_unit_test(test_subtree_at_depth_40),
+        cmocka_unit_test(test_mapped_file_replaced_or_truncated),
         cmocka_unit_test(test_writer_is_deterministic),
         cmocka_unit_test(test_every_truncated_prefix),
         cmocka_unit_test(test_every_bit_flip),
