@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -1022,42 +1023,46 @@ static unsigned char *slurp(const char *path, size_t *len)
 }
 
 /* The caller's sequence (rasterize): atomic_file + oct_writer_finish +
- * commit, in a child process so the fault hook's counters start at zero.
- * Exit status: 0 success, 1 clean failure. */
+ * commit; run in a child process, so that the fault hook's counters start at
+ * zero. Exit status: 0 success, 1 clean failure. */
+_Noreturn static void write_and_exit(const char *target, const test_tree *t, const char *fault)
+{
+    setenv("ATOMIC_FAULT", fault, 1);
+    atomic_file *af = atomic_file_open(target);
+    if (!af)
+        _exit(1);
+    oct_writer_params p = {.levels = t->levels, .edge = t->edge, .surface_count = t->surface_count,
+                           .palette = t->palette};
+    memcpy(p.origin, t->origin, sizeof p.origin);
+    oct_writer *w;
+    if (oct_writer_create(&p, &w) != OCT_OK)
+        _exit(3);
+    for (uint32_t d = 0; d < t->levels; d++)
+        oct_writer_add_masks(w, d, t->masks[d], t->count[d]);
+    oct_writer_add_voxels(w, t->voxels, t->surfaces, t->voxel_count);
+    uint64_t n;
+    oct_err rc = oct_writer_finish(w, atomic_file_stream(af), &n);
+    oct_writer_free(w);
+    if (rc != OCT_OK) {
+        atomic_file_abort(af);
+        _exit(1);
+    }
+    /* Route one write through the hook too, as a producer appending
+     * through atomic_file_write would (zero bytes: the file is complete). */
+    if (atomic_file_write(af, "", 0) != 0) {
+        atomic_file_abort(af);
+        _exit(1);
+    }
+    const char *op;
+    _exit(atomic_file_commit(af, &op) == 0 ? 0 : 1);
+}
+
 static int write_in_child(const char *target, const test_tree *t, const char *fault)
 {
     pid_t pid = fork();
     assert_true(pid >= 0);
-    if (pid == 0) {
-        setenv("ATOMIC_FAULT", fault, 1);
-        atomic_file *af = atomic_file_open(target);
-        if (!af)
-            _exit(1);
-        oct_writer_params p = {.levels = t->levels, .edge = t->edge, .surface_count = t->surface_count,
-                               .palette = t->palette};
-        memcpy(p.origin, t->origin, sizeof p.origin);
-        oct_writer *w;
-        if (oct_writer_create(&p, &w) != OCT_OK)
-            _exit(3);
-        for (uint32_t d = 0; d < t->levels; d++)
-            oct_writer_add_masks(w, d, t->masks[d], t->count[d]);
-        oct_writer_add_voxels(w, t->voxels, t->surfaces, t->voxel_count);
-        uint64_t n;
-        oct_err rc = oct_writer_finish(w, atomic_file_stream(af), &n);
-        oct_writer_free(w);
-        if (rc != OCT_OK) {
-            atomic_file_abort(af);
-            _exit(1);
-        }
-        /* Route one write through the hook too, as a producer appending
-         * through atomic_file_write would (zero bytes: the file is complete). */
-        if (atomic_file_write(af, "", 0) != 0) {
-            atomic_file_abort(af);
-            _exit(1);
-        }
-        const char *op;
-        _exit(atomic_file_commit(af, &op) == 0 ? 0 : 1);
-    }
+    if (pid == 0)
+        write_and_exit(target, t, fault);
     int status;
     assert_int_equal(waitpid(pid, &status, 0), pid);
     assert_true(WIFEXITED(status));
@@ -1111,6 +1116,101 @@ static void test_atomic_write_fault_loop(void **state)
     rmdir(dir);
     free(old_bytes);
     test_tree_free(&old);
+    test_tree_free(&t);
+}
+
+/* SIGTERM at random moments of a large atomic write: the target is the old
+ * file or the complete new one, and no temporary file is left. */
+static void test_signal_during_write(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/test_oct_sig_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char target[600];
+    snprintf(target, sizeof target, "%s/out.oct", dir);
+    test_tree old, t;
+    test_tree_random(&old, 3, 20, 1, 1, 0);
+    test_tree_random(&t, 10, 400000, 2, 3, 0);
+    unsigned char *nb;
+    size_t nlen;
+    assert_int_equal(test_tree_write(&t, &nb, &nlen), OCT_OK);
+    assert_int_equal(write_in_child(target, &old, ""), 0);
+    size_t old_len;
+    unsigned char *old_bytes = slurp(target, &old_len);
+    uint64_t rs = 99;
+    int interrupted = 0;
+    for (int run = 0; run < 10; run++) {
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            signal(SIGTERM, SIG_DFL);
+            write_and_exit(target, &t, "");
+        }
+        usleep((useconds_t)(test_rand(&rs) % 30000));
+        kill(pid, SIGTERM);
+        int status;
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+        assert_true(WIFSIGNALED(status) ? WTERMSIG(status) == SIGTERM : WEXITSTATUS(status) == 0);
+        assert_int_equal(count_tmp_files(dir), 0);
+        size_t l;
+        unsigned char *now = slurp(target, &l);
+        if (l == old_len) {
+            assert_memory_equal(now, old_bytes, l);
+            interrupted++;
+        } else {
+            assert_int_equal(l, nlen);
+            assert_memory_equal(now, nb, l);
+            free(old_bytes);
+            old_bytes = now;
+            old_len = l;
+            now = NULL;
+        }
+        free(now);
+    }
+    print_message("signal during write: %d of 10 runs interrupted before the rename\n", interrupted);
+    unlink(target);
+    rmdir(dir);
+    free(old_bytes);
+    free(nb);
+    test_tree_free(&old);
+    test_tree_free(&t);
+}
+
+/* Validation throughput on a synthetic ~50 MB file, when OCT_BENCH is set. */
+static double seconds_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static void test_validation_throughput(void **state)
+{
+    (void)state;
+    if (!getenv("OCT_BENCH"))
+        skip();
+    test_tree t;
+    test_tree_random(&t, 12, 8100000, 3, 1, 1);
+    unsigned char *buf;
+    size_t len;
+    assert_int_equal(test_tree_write(&t, &buf, &len), OCT_OK);
+    print_message("synthetic file: %.1f MB, %zu voxels, %.2f bytes/voxel\n", (double)len / 1e6,
+                  t.voxel_count, (double)len / (double)t.voxel_count);
+    for (int trust = 0; trust <= 1; trust++) {
+        double best = 1e9;
+        for (int r = 0; r < 20; r++) {
+            oct_file *f;
+            double a = seconds_now();
+            assert_int_equal(oct_open_memory(buf, len, trust ? OCT_OPEN_TRUST : 0, &f, NULL), OCT_OK);
+            double b = seconds_now() - a;
+            oct_close(f);
+            if (b < best)
+                best = b;
+        }
+        print_message("validation %s: %.1f ms, %.0f MB/s\n", trust ? "without CRC" : "with CRC   ",
+                      best * 1e3, (double)len / 1e6 / best);
+    }
+    free(buf);
     test_tree_free(&t);
 }
 
@@ -1186,6 +1286,8 @@ int main(void)
         cmocka_unit_test(test_writer_usage_errors),
         cmocka_unit_test(test_writer_write_failures),
         cmocka_unit_test(test_atomic_write_fault_loop),
+        cmocka_unit_test(test_signal_during_write),
+        cmocka_unit_test(test_validation_throughput),
         cmocka_unit_test(test_make_fuzz_corpus),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
