@@ -34,7 +34,9 @@ static int put(sink *s, const void *data, size_t n)
         return 0;
     s->crc = crc32_z(s->crc, data, n);
     s->bytes += n;
-    if (s->f && fwrite(data, 1, n, s->f) != n) {
+    /* glibc may report a failed flush inside fwrite only through the error
+     * flag, so both are checked: the writer stops at the first failure. */
+    if (s->f && (fwrite(data, 1, n, s->f) != n || ferror(s->f))) {
         if (errno == 0)
             errno = EIO;
         return -1;
