@@ -680,6 +680,46 @@ static void test_trailing_bytes_and_versions(void **state)
     test_tree_free(&t);
 }
 
+/* A newer minor with a 320-byte header (new fields in it, sections shifted
+ * by 64) opens; the same layout claiming minor 0 is refused. */
+static void test_newer_minor_longer_header(void **state)
+{
+    (void)state;
+    test_tree t;
+    unsigned char *buf;
+    size_t len;
+    small_file(&buf, &len, &t);
+    size_t big_len = len + 64;
+    unsigned char *big = calloc(1, big_len);
+    memcpy(big, buf, OCT_HEADER_SIZE);
+    memcpy(big + 320, buf + OCT_HEADER_SIZE, len - OCT_HEADER_SIZE);
+    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR + 1);
+    wr_u32le(big + OCT_OFF_HEADER_SIZE, 320);
+    memset(big + OCT_OFF_HEADER_CRC, 0xab, 64); /* "new fields" where 1.0 had its CRC */
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        uint64_t off = rd_u64le(big + OCT_SEC_OFF(k));
+        if (off)
+            wr_u64le(big + OCT_SEC_OFF(k), off + 64);
+    }
+    test_oct_refresh_crcs(big, big_len); /* header CRC at 316 */
+    oct_file *f;
+    assert_int_equal(oct_open_memory(big, big_len, 0, &f, NULL), OCT_OK);
+    compare(f, &t);
+    oct_close(f);
+    big[0x130] ^= 1; /* the new header bytes are covered by the header CRC */
+    uint64_t at;
+    assert_int_equal(open_buf(big, big_len, 0, &at), OCT_ECRC);
+    assert_int_equal(at, 316);
+    big[0x130] ^= 1;
+    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR);
+    test_oct_refresh_crcs(big, big_len);
+    assert_int_equal(open_buf(big, big_len, 0, &at), OCT_EHEADER);
+    assert_int_equal(at, OCT_OFF_HEADER_SIZE);
+    free(big);
+    free(buf);
+    test_tree_free(&t);
+}
+
 static void test_huge_counts_in_small_files(void **state)
 {
     (void)state;
@@ -1279,6 +1319,7 @@ int main(void)
         cmocka_unit_test(test_header_fields_out_of_range),
         cmocka_unit_test(test_tree_damage),
         cmocka_unit_test(test_trailing_bytes_and_versions),
+        cmocka_unit_test(test_newer_minor_longer_header),
         cmocka_unit_test(test_huge_counts_in_small_files),
         cmocka_unit_test(test_misaligned_buffer),
         cmocka_unit_test(test_not_regular_files),
