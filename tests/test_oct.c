@@ -354,6 +354,48 @@ static void test_mapped_file_replaced_or_truncated(void **state)
     test_tree_free(&b);
 }
 
+/* FORMAT.md, Appendix A: the writer makes exactly the example's bytes. */
+static void test_spec_example(void **state)
+{
+    (void)state;
+    float pal[3] = {1.0f, 0.5f, 0.25f};
+    oct_writer_params p = {.levels = 2, .origin = {-1, -1, -1}, .edge = 2.0, .surface_count = 1, .palette = pal};
+    oct_writer *w;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_OK);
+    const uint8_t root = 0x81, d1[2] = {0x01, 0x80};
+    assert_int_equal(oct_writer_add_masks(w, 0, &root, 1), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 1, d1, 2), OCT_OK);
+    const double n1[3] = {0, 0, 1}, n2[3] = {1, 1, 1};
+    uint32_t v[2] = {oct_voxel_pack(n1, 0.25), oct_voxel_pack(n2, -0.5)};
+    assert_int_equal(v[0], 0x20800800u);
+    assert_int_equal(v[1], 0xc0aaaaaau);
+    assert_int_equal(oct_writer_add_voxels(w, v, NULL, 2), OCT_OK);
+    char *mem;
+    size_t len;
+    FILE *f = open_memstream(&mem, &len);
+    uint64_t n;
+    assert_int_equal(oct_writer_finish(w, f, &n), OCT_OK);
+    oct_writer_free(w);
+    fclose(f);
+    const unsigned char *b = (const unsigned char *)mem;
+    assert_int_equal(len, 460);
+    assert_int_equal(rd_u32le(b + OCT_OFF_HEADER_CRC), 0x506ac706u);
+    assert_int_equal(rd_u32le(b + OCT_SEC_OFF(OCT_SEC_LEVELS) + 16), 0x00f6ddb9u);
+    assert_int_equal(rd_u32le(b + OCT_SEC_OFF(OCT_SEC_NODES) + 16), 0x912a2f8cu);
+    assert_int_equal(rd_u32le(b + OCT_SEC_OFF(OCT_SEC_VOXELS) + 16), 0xb0091dd6u);
+    assert_int_equal(rd_u32le(b + OCT_SEC_OFF(OCT_SEC_PALETTE) + 16), 0xb5cb6adau);
+    static const unsigned char nodes[32] = {0, 0, 0, 0, 0, 0, 0, 0, 0x81, 0, 0, 0, 0, 0, 0, 0,
+                                            0, 0, 0, 0, 0, 0, 0, 0, 0x01, 0x80, 0, 0, 0, 0, 0, 0};
+    assert_memory_equal(b + 320, nodes, 32);
+    oct_file *of;
+    assert_int_equal(oct_open_memory(mem, len, 0, &of, NULL), OCT_OK);
+    const oct_tree *t = oct_get_tree(of);
+    assert_int_equal(oct_child_index(t->groups[0], 0, 7), 1);
+    assert_int_equal(oct_child_index(t->groups[1], 1, 7), 1);
+    oct_close(of);
+    free(mem);
+}
+
 static void test_writer_is_deterministic(void **state)
 {
     (void)state;
@@ -1312,6 +1354,7 @@ int main(void)
         cmocka_unit_test(test_deepest_tree),
         cmocka_unit_test(test_subtree_at_depth_40),
         cmocka_unit_test(test_mapped_file_replaced_or_truncated),
+        cmocka_unit_test(test_spec_example),
         cmocka_unit_test(test_writer_is_deterministic),
         cmocka_unit_test(test_every_truncated_prefix),
         cmocka_unit_test(test_every_bit_flip),
