@@ -1081,6 +1081,88 @@ static void test_writer_write_failures(void **state)
     test_tree_free(&t);
 }
 
+/* Feeds t to a new writer in chunks; on ENOMEM retries the call once when
+ * `retry` (a single injected failure must leave the writer usable). */
+static oct_err feed_writer(const test_tree *t, int retry, unsigned char **out, size_t *out_len)
+{
+    oct_writer_params p = {.levels = t->levels, .edge = t->edge, .surface_count = t->surface_count,
+                           .palette = t->palette};
+    memcpy(p.origin, t->origin, sizeof p.origin);
+    oct_writer *w = NULL;
+    oct_err rc = oct_writer_create(&p, &w);
+    if (rc == OCT_ENOMEM && retry)
+        rc = oct_writer_create(&p, &w);
+    for (uint32_t d = 0; d < t->levels && rc == OCT_OK; d++) {
+        for (size_t i = 0; i < t->count[d] && rc == OCT_OK; i += 5000) {
+            size_t n = t->count[d] - i < 5000 ? t->count[d] - i : 5000;
+            rc = oct_writer_add_masks(w, d, t->masks[d] + i, n);
+            if (rc == OCT_ENOMEM && retry)
+                rc = oct_writer_add_masks(w, d, t->masks[d] + i, n);
+        }
+    }
+    for (size_t i = 0; i < t->voxel_count && rc == OCT_OK; i += 3000) {
+        size_t n = t->voxel_count - i < 3000 ? t->voxel_count - i : 3000;
+        rc = oct_writer_add_voxels(w, t->voxels + i, t->surfaces + i, n);
+        if (rc == OCT_ENOMEM && retry)
+            rc = oct_writer_add_voxels(w, t->voxels + i, t->surfaces + i, n);
+    }
+    char *mem = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&mem, &len);
+    if (rc == OCT_OK)
+        rc = oct_writer_finish(w, f, NULL);
+    oct_writer_free(w);
+    fclose(f);
+    *out = (unsigned char *)mem;
+    *out_len = len;
+    return rc;
+}
+
+static void test_allocation_failures(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 7, 30000, 3, 21, 0);
+    unsigned char *good;
+    size_t good_len;
+    assert_int_equal(feed_writer(&t, 0, &good, &good_len), OCT_OK);
+    for (int sticky = 0; sticky <= 1; sticky++) {
+        for (long n = 1;; n++) {
+            unsigned char *out;
+            size_t len;
+            oct__alloc_fail_after(n, sticky);
+            oct_err rc = feed_writer(&t, !sticky, &out, &len);
+            oct__alloc_fail_after(0, 0);
+            if (rc == OCT_OK) {
+                assert_int_equal(len, good_len);
+                assert_memory_equal(out, good, len);
+                free(out);
+                if (!sticky && n < 40)
+                    continue; /* the failure may land after the last allocation */
+                break;
+            }
+            free(out);
+            assert_int_equal(rc, OCT_ENOMEM);
+            assert_true(sticky);
+            assert_true(n < 1000);
+        }
+    }
+    /* The reader allocates its handle and, for a misaligned buffer, a copy. */
+    unsigned char *raw = malloc(good_len + 1);
+    memcpy(raw + 1, good, good_len);
+    for (long n = 1; n <= 3; n++) {
+        oct_file *f = (oct_file *)1;
+        oct__alloc_fail_after(n, 0);
+        oct_err rc = oct_open_memory(raw + 1, good_len, 0, &f, NULL);
+        oct__alloc_fail_after(0, 0);
+        assert_int_equal(rc, n < 3 ? OCT_ENOMEM : OCT_OK);
+        oct_close(f);
+    }
+    free(raw);
+    free(good);
+    test_tree_free(&t);
+}
+
 static int count_tmp_files(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -1371,6 +1453,7 @@ int main(void)
         cmocka_unit_test(test_offset_codec),
         cmocka_unit_test(test_writer_usage_errors),
         cmocka_unit_test(test_writer_write_failures),
+        cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_atomic_write_fault_loop),
         cmocka_unit_test(test_signal_during_write),
         cmocka_unit_test(test_validation_throughput),
