@@ -141,6 +141,11 @@ void oct_close(oct_file *f); /* accepts NULL */
 const oct_tree *oct_get_tree(const oct_file *f);
 const oct_info *oct_get_info(const oct_file *f);
 
+/* Prints the human summary `render --info` shows (format version, levels,
+ * cube, nodes per depth, voxels, file bytes, bytes per voxel) to `out`, a
+ * FILE *. Returns 0, or -1 when the stream reports an error. */
+int oct_print_info(void *out /* FILE * */, const oct_file *f);
+
 /* --- Writer ------------------------------------------------------------ */
 
 typedef struct oct_writer oct_writer;

@@ -1,0 +1,206 @@
+/* interval: sound interval arithmetic in double, with outward rounding by
+ * nextafter, for the operations of the scene language. */
+#ifndef INTERVAL_H
+#define INTERVAL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* A closed interval [lo, hi] of extended reals (ends may be +-inf).
+ * The NaN interval (lo and hi NaN) means "undefined everywhere": it
+ * encloses nothing useful and callers must treat it as "anything".
+ *
+ * Rounding. Every operation whose double result may be inexact widens it
+ * outward with nextafter: one ulp for + - * / sqrt (IEEE 754 rounds these
+ * correctly, so the true value is within half an ulp), two ulps for the libm
+ * functions exp log sin cos tan pow (glibc documents at most 1-2 ulp for
+ * these; see also the MPFR cross-checks in tests/test_interval.c). We do not
+ * use fesetround: it needs -frounding-math to stop the compiler from folding
+ * and moving floating-point code across the mode switch, it is slow to toggle,
+ * it is per-thread state, and it says nothing about libm's accuracy anyway.
+ *
+ * Flags. Each operation ORs INTERVAL_MAYBE_NAN into *flags when some point
+ * of its input box may give NaN (sqrt/log/pow of a negative number, 0/0,
+ * 0*inf, inf-inf, inf/inf, sin/cos/tan of an infinite argument). The
+ * returned interval then encloses the operation's value at every point
+ * where it is defined (not NaN); if it is defined nowhere the result is the
+ * NaN interval. A NaN input interval gives a NaN result. Rasterizer rule: a
+ * flagged or NaN result means "may contain surface: subdivide". */
+typedef struct interval {
+    double lo, hi;
+} interval;
+
+enum { INTERVAL_MAYBE_NAN = 1u };
+
+/* True when i is the NaN interval. */
+/* The NaN interval. */
+/* [lo, hi] widened by one ulp each way unless lo == hi is exact: used for
+ * constants such as 0.78 or pi that a double cannot hold. */
+interval interval_around(double v);
+
+/* Division by an interval that touches 0 gives [-inf, inf]. */
+interval interval_div(interval a, interval b, unsigned *flags);
+/* a*a, tight: [-2,3]^2 = [0,9]. */
+interval interval_sqrt(interval a, unsigned *flags);
+/* Overflow gives +inf, never NaN. */
+interval interval_exp(interval a, unsigned *flags);
+/* log(0) = -inf (a value, not NaN), log of a negative = NaN. */
+interval interval_log(interval a, unsigned *flags);
+interval interval_sin(interval a, unsigned *flags);
+interval interval_cos(interval a, unsigned *flags);
+/* Across a pole (or wider than pi) gives [-inf, inf]. */
+interval interval_tan(interval a, unsigned *flags);
+/* a^p for a constant non-integer p (finite): defined for a >= 0 only,
+ * pow(0, p<0) = +inf. Integer powers are multiplications (see tape.h). */
+interval interval_powc(interval a, double p, unsigned *flags);
+/* Smallest interval holding both. NaN interval if either is NaN. */
+
+/* ---- Inline part: the cheap operations the evaluators call most. ---- */
+
+/* At least nextafter(x, +inf), without the libm call (it was the hot spot
+ * of every interval operation): step the bit pattern. NaN and +inf stay.
+ * Zero and subnormals step to 0 or DBL_MIN (2^-1022) instead: a wider but
+ * still outward step that keeps subnormals, ~100 times slower on x86, from
+ * spreading through the evaluation. */
+static inline double interval_next_up(double x)
+{
+    if (x != x || x == INFINITY)
+        return x;
+    if (x < 0x1p-1022 && x > -0x1p-1022)
+        return x < 0.0 ? 0.0 : 0x1p-1022;
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u = x > 0.0 ? u + 1 : u - 1;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+/* At least nextafter(x, -inf) (see interval_next_up). */
+static inline double interval_next_down(double x) { return -interval_next_up(-x); }
+
+/* Internal helpers (double underscore): not for use outside interval.[ch]. */
+static inline double interval__min2(double a, double b) { return a < b ? a : b; } /* no NaN */
+static inline double interval__max2(double a, double b) { return a > b ? a : b; }
+static inline int interval__has_zero(interval a) { return a.lo <= 0.0 && a.hi >= 0.0; }
+static inline int interval__has_inf(interval a) { return isinf(a.lo) || isinf(a.hi); }
+static inline int interval__isnan(interval a) { return a.lo != a.lo || a.hi != a.hi; }
+static inline interval interval__mk(double lo, double hi) { interval r = {lo, hi}; return r; }
+static inline interval interval__nan_flag(unsigned *flags)
+{
+    *flags |= INTERVAL_MAYBE_NAN;
+    return interval__mk(NAN, NAN);
+}
+
+/* True when i is the NaN interval. */
+static inline int interval_is_nan(interval i) { return interval__isnan(i); }
+
+/* The NaN interval. */
+static inline interval interval_nan(void) { return interval__mk(NAN, NAN); }
+
+/* Smallest interval holding both. NaN interval if either is NaN. */
+static inline interval interval_hull(interval a, interval b)
+{
+    if (interval__isnan(a) || interval__isnan(b))
+        return interval__mk(NAN, NAN);
+    return interval__mk(a.lo < b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
+}
+
+static inline interval interval_neg(interval a) { return interval__mk(-a.hi, -a.lo); }
+
+static inline interval interval_add(interval a, interval b, unsigned *flags)
+{
+    if (interval__isnan(a) || interval__isnan(b))
+        return interval__nan_flag(flags);
+    /* Infinite ends are points of the box (an overflowed value), so
+     * -inf + inf may happen inside even when no corner shows it. */
+    if ((a.lo == -INFINITY && b.hi == INFINITY) || (a.hi == INFINITY && b.lo == -INFINITY))
+        *flags |= INTERVAL_MAYBE_NAN;
+    double lo = a.lo + b.lo, hi = a.hi + b.hi;
+    if (lo != lo) { /* -inf + inf: an operand is infinite at some point */
+        lo = -INFINITY;
+        *flags |= INTERVAL_MAYBE_NAN;
+    }
+    if (hi != hi) {
+        hi = INFINITY;
+        *flags |= INTERVAL_MAYBE_NAN;
+    }
+    return interval__mk(interval_next_down(lo), interval_next_up(hi));
+}
+
+static inline interval interval_sub(interval a, interval b, unsigned *flags)
+{
+    return interval_add(a, interval_neg(b), flags);
+}
+
+/* x*y where 0*inf (NaN) counts as 0 for the bounds and raises the flag:
+ * the product is bilinear, so the limits near that corner lie between 0
+ * and the other corners. */
+static inline double interval__mul0(double x, double y, int *bad)
+{
+    double p = x * y;
+    if (p != p) {
+        *bad = 1;
+        return 0.0;
+    }
+    return p;
+}
+
+static inline interval interval_mul(interval a, interval b, unsigned *flags)
+{
+    if (interval__isnan(a) || interval__isnan(b))
+        return interval__nan_flag(flags);
+    int bad = (interval__has_zero(a) && interval__has_inf(b)) || (interval__has_zero(b) && interval__has_inf(a)); /* 0*inf inside */
+    double p1 = interval__mul0(a.lo, b.lo, &bad), p2 = interval__mul0(a.lo, b.hi, &bad);
+    double p3 = interval__mul0(a.hi, b.lo, &bad), p4 = interval__mul0(a.hi, b.hi, &bad);
+    double lo = interval__min2(interval__min2(p1, p2), interval__min2(p3, p4));
+    double hi = interval__max2(interval__max2(p1, p2), interval__max2(p3, p4));
+    if (bad)
+        *flags |= INTERVAL_MAYBE_NAN;
+    return interval__mk(interval_next_down(lo), interval_next_up(hi));
+}
+
+/* a*a, tight: [-2,3]^2 = [0,9]. */
+static inline interval interval_sqr(interval a, unsigned *flags)
+{
+    if (interval__isnan(a))
+        return interval__nan_flag(flags);
+    double l, h;
+    if (a.lo >= 0.0) {
+        l = a.lo * a.lo;
+        h = a.hi * a.hi;
+    } else if (a.hi <= 0.0) {
+        l = a.hi * a.hi;
+        h = a.lo * a.lo;
+    } else {
+        double m = -a.lo > a.hi ? -a.lo : a.hi;
+        l = 0.0;
+        h = m * m;
+    }
+    l = interval_next_down(l);
+    return interval__mk(l < 0.0 ? 0.0 : l, interval_next_up(h));
+}
+
+static inline interval interval_abs(interval a)
+{
+    if (a.lo >= 0.0)
+        return a;
+    if (a.hi <= 0.0)
+        return interval__mk(-a.hi, -a.lo);
+    return interval__mk(0.0, -a.lo > a.hi ? -a.lo : a.hi);
+}
+
+static inline interval interval_min(interval a, interval b)
+{
+    if (interval__isnan(a) || interval__isnan(b))
+        return interval__mk(NAN, NAN);
+    return interval__mk(a.lo < b.lo ? a.lo : b.lo, a.hi < b.hi ? a.hi : b.hi);
+}
+
+static inline interval interval_max(interval a, interval b)
+{
+    if (interval__isnan(a) || interval__isnan(b))
+        return interval__mk(NAN, NAN);
+    return interval__mk(a.lo > b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
+}
+
+#endif

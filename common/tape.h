@@ -1,0 +1,143 @@
+/* tape: an implicit function compiled to a flat SSA instruction array, and
+ * its evaluators (point, gradient, interval, interval gradient) and pruner. */
+#ifndef TAPE_H
+#define TAPE_H
+
+#include <stdint.h>
+
+#include "common/interval.h"
+
+/* Instruction i writes slot i; operands name earlier slots, so a tape is
+ * evaluated by one forward loop. */
+typedef enum tape_op {
+    TAPE_CONST,  /* a = index into the constant pool */
+    TAPE_X, TAPE_Y, TAPE_Z,
+    TAPE_NEG, TAPE_SQUARE, TAPE_SQRT, TAPE_EXP, TAPE_LOG, TAPE_ABS,
+    TAPE_SIN, TAPE_COS, TAPE_TAN,
+    TAPE_ADD, TAPE_SUB, TAPE_MUL, TAPE_DIV, TAPE_MIN, TAPE_MAX,
+    TAPE_POWC,   /* slot a ^ pool[b].v, the exponent exact and not an integer */
+    TAPE_NOPS
+} tape_op;
+
+typedef struct tape_insn {
+    uint32_t op; /* tape_op */
+    uint32_t a, b;
+} tape_insn;
+
+/* A constant: v is the double the point evaluators use; [lo, hi] encloses
+ * the real number written in the scene (lo == hi == v when v is exact). */
+typedef struct tape_const {
+    double v, lo, hi;
+} tape_const;
+
+/* A tape. Evaluators only read it, so one tape may be shared by threads.
+ * The output is slot `root`. A pruned tape (tape_prune) borrows the
+ * constant pool of the tape it came from and its instructions live in the
+ * caller's buffer. */
+typedef struct tape {
+    const tape_insn *insn;
+    uint32_t n, root;
+    const tape_const *konst;
+    uint32_t nconst;
+    int owned; /* insn and konst were allocated by tape_builder_finish */
+    uint32_t ntree; /* instructions requested while building, before sharing,
+                       folding and dead-code removal (for statistics) */
+} tape;
+
+/* Forward-mode dual numbers for the gradient evaluators. */
+typedef struct tape_dual {
+    double v, d[3];
+} tape_dual;
+typedef struct tape_idual {
+    interval v, d[3];
+} tape_idual;
+
+/* ---- Building ---------------------------------------------------------- */
+
+enum tape_err {
+    TAPE_OK = 0,
+    TAPE_ENOMEM = -1,
+    TAPE_ETOOBIG = -2,   /* more than TAPE_MAX_INSNS instructions */
+    TAPE_EDOMAIN = -3,   /* a constant sub-expression is undefined or not finite */
+    TAPE_EEXPONENT = -4, /* integer exponent beyond TAPE_MAX_POWI */
+};
+#define TAPE_MAX_INSNS (1u << 22)
+#define TAPE_MAX_POWI 1024
+
+const char *tape_strerror(int err);
+
+typedef struct tape_builder tape_builder;
+
+/* New empty builder; NULL when out of memory. Free with tape_builder_free. */
+tape_builder *tape_builder_new(void);
+void tape_builder_free(tape_builder *b); /* accepts NULL */
+
+/* Each emitter returns the slot of the value (>= 0) or a negative tape_err.
+ * Equal instructions are shared (hash-consing; + * min max are commutative),
+ * operations on constants are folded, and a folded constant that is not
+ * finite or undefined (exp(1000), 1/0, sqrt(-1)) is TAPE_EDOMAIN. */
+int32_t tape_emit_const(tape_builder *b, double v, double lo, double hi);
+/* axis 0, 1, 2 for x, y, z. */
+int32_t tape_emit_var(tape_builder *b, int axis);
+/* op is one of the unary ops NEG..TAN. */
+int32_t tape_emit_unary(tape_builder *b, tape_op op, int32_t a);
+/* op is one of ADD..MAX. */
+int32_t tape_emit_binary(tape_builder *b, tape_op op, int32_t a, int32_t c);
+/* base ^ exponent, also pow(base, exponent). An exact integer exponent
+ * becomes squarings and multiplications (x^4 = square(square(x)), negative
+ * ones a division of 1 by that); another exact constant becomes POWC (base
+ * >= 0); e^u becomes exp(u); anything else is exp(exponent * log(base)),
+ * defined for base > 0 only. */
+int32_t tape_emit_pow(tape_builder *b, int32_t base, int32_t exponent);
+/* True when slot s is a constant; *v receives its double. */
+int tape_slot_is_const(const tape_builder *b, int32_t s, double *v);
+
+/* Moves the instructions reachable from `root` into a new tape (dead code
+ * dropped) and resets nothing else: free the builder afterwards. Returns
+ * TAPE_OK or TAPE_ENOMEM. The caller frees *out with tape_free. */
+int tape_builder_finish(tape_builder *b, int32_t root, tape *out);
+/* Frees an owned tape's arrays; a borrowed (pruned) tape is left alone. */
+void tape_free(tape *t);
+
+/* ---- Evaluating -------------------------------------------------------- */
+/* All evaluators are reentrant: `slots` is the caller's scratch of at least
+ * t->n elements; nothing is allocated and no global state is touched. */
+
+/* f(x, y, z) in double. NaN where f is undefined (sqrt(-1), 0/0); min/max
+ * propagate NaN. */
+double tape_eval(const tape *t, double x, double y, double z, double *slots);
+
+/* f and its gradient at p by forward-mode AD; grad[3] receives df/dx,
+ * df/dy, df/dz. abs/min/max use the derivative of the branch taken. */
+double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dual *slots);
+
+/* Sound enclosure of f over the box box[0] x box[1] x box[2]; *flags
+ * receives INTERVAL_MAYBE_NAN when f may be undefined somewhere in the box
+ * (see interval.h: then the result encloses f only where it is defined,
+ * and a NaN interval means defined nowhere). Slot i of `slots` receives the
+ * enclosure of instruction i, for tape_prune. */
+interval tape_eval_interval(const tape *t, const interval box[3], interval *slots, unsigned *flags);
+
+/* Enclosures of f and of each partial derivative over the box (forward-mode
+ * AD in interval arithmetic): for every p in the box where f is defined and
+ * differentiable, grad f(p) lies in grad[0..2] (unless *flags is set). */
+interval tape_eval_interval_grad(const tape *t, const interval box[3], interval grad[3],
+                                 tape_idual *slots, unsigned *flags);
+
+/* ---- Pruning ----------------------------------------------------------- */
+
+/* Shortens t for the box whose slot enclosures `slots` (from
+ * tape_eval_interval over that box, with its `flags`) describe: a min or
+ * max whose operands' enclosures do not overlap keeps only the winner, and
+ * instructions no longer reachable are dropped. The result agrees with t
+ * at every point of that box and its sub-boxes. When flags is nonzero (f
+ * may be NaN somewhere) or slots is NULL, only dead code is removed.
+ * `out_insn` and `scratch` are caller buffers of t->n elements each. *out
+ * borrows t's constant pool and out_insn. Returns out->n. Two linear passes. */
+uint32_t tape_prune(const tape *t, const interval *slots, unsigned flags, tape_insn *out_insn,
+                    uint32_t *scratch, tape *out);
+
+/* Name of an op, for dumps. */
+const char *tape_op_name(tape_op op);
+
+#endif

@@ -1,0 +1,384 @@
+/* oct_read: map an .oct file read-only and validate all of it, in one linear
+ * pass, before handing out the tree view (FORMAT.md, "Reader checks"). */
+#include "format/oct.h"
+#include "format/oct_layout.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+struct oct_file {
+    const unsigned char *data; /* the validated bytes */
+    size_t size;
+    void *map;   /* mmap'd region (oct_open), or NULL */
+    void *owned; /* aligned copy (oct_open_memory of a misaligned buffer), or NULL */
+    oct_tree tree;
+    oct_info info;
+};
+
+static const char *const err_text[OCT_ERR_COUNT] = {
+    [OCT_OK] = "success",
+    [OCT_EIO] = "I/O error",
+    [OCT_ENOMEM] = "out of memory",
+    [OCT_ENOTFILE] = "not a regular file",
+    [OCT_ETRUNC] = "truncated file",
+    [OCT_EMAGIC] = "not an .oct file (bad magic)",
+    [OCT_EVERSION] = "unsupported format version",
+    [OCT_EHEADER] = "corrupt: header field out of range",
+    [OCT_ERESERVED] = "corrupt: reserved field or padding not zero",
+    [OCT_ESECTION] = "corrupt: section misplaced, misaligned or of the wrong size",
+    [OCT_ETREE] = "corrupt: inconsistent tree structure",
+    [OCT_EVOXEL] = "corrupt: voxel, surface or palette value out of range",
+    [OCT_ECRC] = "corrupt: checksum mismatch",
+    [OCT_EUSAGE] = "API misuse",
+};
+
+const char *oct_strerror(oct_err err)
+{
+    if ((unsigned)err >= OCT_ERR_COUNT)
+        return "unknown error";
+    return err_text[err];
+}
+
+/* Fails the validation with `err` at byte offset `off` unless `cond` holds.
+ * With -DOCT_TRACE_CHECKS the failing check is named on stderr (debugging
+ * only: library code does not print otherwise). */
+#ifdef OCT_TRACE_CHECKS
+#define TRACE_FAIL(cond) fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond)
+#else
+#define TRACE_FAIL(cond) ((void)0)
+#endif
+#define CHECK(cond, err, off)                                                                      \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            TRACE_FAIL(cond);                                                                      \
+            *where = (off);                                                                        \
+            return (err);                                                                          \
+        }                                                                                          \
+    } while (0)
+
+static uint64_t groups_of(uint64_t nodes) { return nodes / 8 + (nodes % 8 != 0); }
+
+static int all_zero(const unsigned char *p, uint64_t n, uint64_t *first)
+{
+    for (uint64_t i = 0; i < n; i++) {
+        if (p[i]) {
+            *first = i;
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* 0x80 in every byte of v that is zero (the classic "has zero byte" test,
+ * exact when restricted to the high bits of bytes that were zero). */
+static uint64_t zero_bytes(uint64_t v)
+{
+    const uint64_t lo7 = UINT64_C(0x7f7f7f7f7f7f7f7f);
+    return ~(((v & lo7) + lo7) | v | lo7);
+}
+
+static oct_err check_tree(const unsigned char *p, uint64_t nodes_off, uint64_t levels_off,
+                          const oct_tree *t, uint64_t *where)
+{
+    uint64_t g_off = nodes_off;
+    for (uint32_t d = 0; d < t->levels; d++) {
+        const uint64_t n = t->node_count[d], ng = groups_of(n);
+        uint64_t sum = 0;
+        for (uint64_t g = 0; g < ng; g++, g_off += 16) {
+            CHECK(rd_u64le(p + g_off) == sum, OCT_ETREE, g_off); /* forward, dense, unshared */
+            uint64_t m = rd_u64le(p + g_off + 8);
+            uint64_t live = n - 8 * g >= 8 ? 8 : n - 8 * g; /* nodes in this group */
+            uint64_t used = live == 8 ? ~UINT64_C(0) : (UINT64_C(1) << (8 * live)) - 1;
+            uint64_t z = zero_bytes(m) & used;
+            CHECK(z == 0, OCT_ETREE, g_off + 8 + (uint64_t)(__builtin_ctzll(z | (UINT64_C(1) << 63)) / 8));
+            uint64_t pad = m & ~used;
+            CHECK(pad == 0, OCT_ERESERVED, g_off + 8 + (uint64_t)(__builtin_ctzll(pad | (UINT64_C(1) << 63)) / 8));
+            sum += oct_popcount64(m);
+        }
+        if (d + 1 < t->levels)
+            CHECK(sum == t->node_count[d + 1], OCT_ETREE, levels_off + 8 * (d + 1));
+        else
+            CHECK(sum == t->voxel_count, OCT_ETREE, (uint64_t)OCT_OFF_VOXEL_COUNT);
+    }
+    return OCT_OK;
+}
+
+static oct_err validate(oct_file *f, unsigned flags, uint64_t *where)
+{
+    const unsigned char *p = f->data;
+    const uint64_t size = f->size;
+    oct_tree *t = &f->tree;
+    oct_info *in = &f->info;
+    *where = 0;
+
+    /* Header: identity, then each field's range. */
+    size_t mlen = size < OCT_MAGIC_SIZE ? (size_t)size : OCT_MAGIC_SIZE;
+    CHECK(size > 0, OCT_ETRUNC, 0);
+    CHECK(memcmp(p, OCT_MAGIC, mlen) == 0, OCT_EMAGIC, 0);
+    CHECK(size >= OCT_HEADER_SIZE, OCT_ETRUNC, size);
+    in->version_major = rd_u16le(p + OCT_OFF_MAJOR);
+    in->version_minor = rd_u16le(p + OCT_OFF_MINOR);
+    CHECK(in->version_major == OCT_VERSION_MAJOR, OCT_EVERSION, (uint64_t)OCT_OFF_MAJOR);
+    const int known_minor = in->version_minor <= OCT_VERSION_MINOR;
+    const uint32_t hsize = rd_u32le(p + OCT_OFF_HEADER_SIZE);
+    CHECK(hsize % OCT_ALIGN == 0 && (known_minor ? hsize == OCT_HEADER_SIZE : hsize >= OCT_HEADER_SIZE),
+          OCT_EHEADER, (uint64_t)OCT_OFF_HEADER_SIZE);
+    CHECK(hsize <= size, OCT_ETRUNC, (uint64_t)OCT_OFF_HEADER_SIZE);
+    CHECK(rd_u32le(p + OCT_OFF_BOM_U32) == OCT_BOM_U32, OCT_EHEADER, (uint64_t)OCT_OFF_BOM_U32);
+    CHECK(rd_f64le(p + OCT_OFF_BOM_F64) == OCT_BOM_F64, OCT_EHEADER, (uint64_t)OCT_OFF_BOM_F64);
+    CHECK(rd_u32le(p + OCT_OFF_FLAGS) == 0, OCT_EHEADER, (uint64_t)OCT_OFF_FLAGS);
+    t->levels = rd_u32le(p + OCT_OFF_LEVELS);
+    CHECK(t->levels >= 1 && t->levels <= OCT_MAX_LEVELS, OCT_EHEADER, (uint64_t)OCT_OFF_LEVELS);
+    in->root_depth = rd_u32le(p + OCT_OFF_ROOT_DEPTH);
+    CHECK(in->root_depth <= OCT_MAX_ROOT_DEPTH, OCT_EHEADER, (uint64_t)OCT_OFF_ROOT_DEPTH);
+    for (int i = 0; i < 3; i++) {
+        in->root_cell[i] = rd_u64le(p + OCT_OFF_ROOT_CELL + 8 * i);
+        CHECK(in->root_cell[i] < (UINT64_C(1) << in->root_depth), OCT_EHEADER,
+              (uint64_t)OCT_OFF_ROOT_CELL + 8 * (uint64_t)i);
+    }
+    in->grid_edge = rd_f64le(p + OCT_OFF_GRID_EDGE);
+    CHECK(oct_cube_ok(0.0, in->grid_edge, in->root_depth, t->levels), OCT_EHEADER,
+          (uint64_t)OCT_OFF_GRID_EDGE);
+    t->edge = ldexp(in->grid_edge, -(int)in->root_depth); /* exact: the voxel edge is normal */
+    for (int i = 0; i < 3; i++) {
+        in->grid_origin[i] = rd_f64le(p + OCT_OFF_GRID_ORIGIN + 8 * i);
+        CHECK(oct_cube_ok(in->grid_origin[i], in->grid_edge, in->root_depth, t->levels), OCT_EHEADER,
+              (uint64_t)OCT_OFF_GRID_ORIGIN + 8 * (uint64_t)i);
+        t->origin[i] = in->grid_origin[i] + (double)in->root_cell[i] * t->edge;
+    }
+    t->surface_count = rd_u32le(p + OCT_OFF_SURFACE_COUNT);
+    CHECK(t->surface_count >= 1 && t->surface_count <= OCT_MAX_SURFACES, OCT_EHEADER,
+          (uint64_t)OCT_OFF_SURFACE_COUNT);
+    t->voxel_count = rd_u64le(p + OCT_OFF_VOXEL_COUNT);
+    if (known_minor) { /* a newer minor may give meaning to these bytes */
+        uint64_t at;
+        CHECK(rd_u32le(p + OCT_OFF_RESERVED0) == 0, OCT_ERESERVED, (uint64_t)OCT_OFF_RESERVED0);
+        for (int k = 0; k < OCT_SEC_COUNT; k++)
+            CHECK(rd_u32le(p + OCT_SEC_OFF(k) + 20) == 0, OCT_ERESERVED, (uint64_t)OCT_SEC_OFF(k) + 20);
+        CHECK(all_zero(p + OCT_OFF_RESERVED1, OCT_OFF_HEADER_CRC - OCT_OFF_RESERVED1, &at),
+              OCT_ERESERVED, OCT_OFF_RESERVED1 + at);
+    }
+
+    /* Sections: each of the expected size, in table order, each at the first
+     * 64-byte boundary after the previous one, inside the file. */
+    uint64_t off[OCT_SEC_COUNT], len[OCT_SEC_COUNT], end = hsize;
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        const uint64_t e = OCT_SEC_OFF(k);
+        off[k] = rd_u64le(p + e);
+        len[k] = rd_u64le(p + e + 8);
+        uint64_t want;
+        switch (k) {
+        case OCT_SEC_LEVELS: want = 8u * t->levels; break;
+        case OCT_SEC_NODES:
+            want = 0;
+            for (uint32_t d = 0; d < t->levels; d++)
+                want += 16 * groups_of(t->node_count[d]); /* counts <= 8^d: no overflow */
+            break;
+        case OCT_SEC_VOXELS: want = 4 * t->voxel_count; break; /* voxel_count <= 8^20 */
+        case OCT_SEC_SURFACES: want = t->surface_count > 1 ? t->voxel_count : 0; break;
+        default: want = 12u * t->surface_count; break;
+        }
+        CHECK(len[k] == want, OCT_ESECTION, e + 8);
+        if (len[k] == 0) {
+            CHECK(off[k] == 0 && rd_u32le(p + e + 16) == 0, OCT_ESECTION, e);
+        } else {
+            CHECK(off[k] % OCT_ALIGN == 0 && off[k] >= end, OCT_ESECTION, e); /* aligned, no overlap */
+            CHECK(off[k] == oct_align_up(end), OCT_ESECTION, e);             /* no gap */
+            CHECK(off[k] <= size && len[k] <= size - off[k], OCT_ETRUNC, e);
+            uint64_t at;
+            CHECK(all_zero(p + end, off[k] - end, &at), OCT_ERESERVED, end + at);
+            end = off[k] + len[k];
+        }
+        if (k == OCT_SEC_LEVELS) { /* the counts bound every later size */
+            for (uint32_t d = 0; d < t->levels; d++) {
+                t->node_count[d] = rd_u64le(p + off[k] + 8 * d);
+                uint64_t cap = d == 0 ? 1 : 8 * t->node_count[d - 1];
+                CHECK(t->node_count[d] <= cap, OCT_ETREE, off[k] + 8 * d);
+            }
+            CHECK(t->voxel_count <= 8 * t->node_count[t->levels - 1], OCT_ETREE,
+                  (uint64_t)OCT_OFF_VOXEL_COUNT);
+        }
+    }
+    CHECK(known_minor ? size == end : size >= end, OCT_ESECTION, end); /* trailing bytes */
+
+    /* Tree structure, then voxel records, surfaces and palette. */
+    oct_err rc = check_tree(p, off[OCT_SEC_NODES], off[OCT_SEC_LEVELS], t, where);
+    if (rc != OCT_OK)
+        return rc;
+    const unsigned char *v = p + off[OCT_SEC_VOXELS];
+    for (uint64_t i = 0; i < t->voxel_count; i++)
+        CHECK(v[4 * i + 3] != 0x80, OCT_EVOXEL, off[OCT_SEC_VOXELS] + 4 * i + 3); /* offset -128 */
+    if (t->surface_count > 1) {
+        const unsigned char *s = p + off[OCT_SEC_SURFACES];
+        for (uint64_t i = 0; i < t->voxel_count; i++)
+            CHECK(s[i] < t->surface_count, OCT_EVOXEL, off[OCT_SEC_SURFACES] + i);
+    }
+    for (uint32_t i = 0; i < 3 * t->surface_count; i++) {
+        float c;
+        memcpy(&c, p + off[OCT_SEC_PALETTE] + 4 * i, 4);
+        CHECK(isfinite(c) && c >= 0.0f && c <= 1.0f, OCT_EVOXEL, off[OCT_SEC_PALETTE] + 4 * i);
+    }
+
+    /* Checksums last: a damaged file is then reported by its first broken
+     * structure when it has one, and any other damage still fails here. */
+    if (!(flags & OCT_OPEN_TRUST)) {
+        CHECK((uint32_t)crc32_z(0, p, hsize - 4) == rd_u32le(p + hsize - 4), OCT_ECRC, hsize - 4);
+        for (int k = 0; k < OCT_SEC_COUNT; k++) {
+            uLong c = crc32_z(0, len[k] ? p + off[k] : NULL, (size_t)len[k]);
+            CHECK((uint32_t)c == rd_u32le(p + OCT_SEC_OFF(k) + 16), OCT_ECRC, (uint64_t)OCT_SEC_OFF(k) + 16);
+        }
+    }
+
+    /* The view. Sections are 64-byte aligned in a buffer at least 8-byte
+     * aligned, so the casts below are aligned. */
+    uint64_t g_off = off[OCT_SEC_NODES];
+    in->total_nodes = 0;
+    for (uint32_t d = 0; d < t->levels; d++) {
+        t->groups[d] = t->node_count[d] ? (const oct_group *)(const void *)(p + g_off) : NULL;
+        g_off += 16 * groups_of(t->node_count[d]);
+        in->total_nodes += t->node_count[d];
+    }
+    t->voxels = t->voxel_count ? (const uint32_t *)(const void *)(p + off[OCT_SEC_VOXELS]) : NULL;
+    t->surfaces = t->surface_count > 1 && t->voxel_count ? p + off[OCT_SEC_SURFACES] : NULL;
+    t->palette = (const float *)(const void *)(p + off[OCT_SEC_PALETTE]);
+    in->file_size = size;
+    return OCT_OK;
+}
+
+static oct_err finish_open(oct_file *f, unsigned flags, oct_file **out, uint64_t *err_offset)
+{
+    uint64_t where = 0;
+    oct_err rc = validate(f, flags, &where);
+    if (err_offset)
+        *err_offset = rc == OCT_OK ? 0 : where;
+    if (rc != OCT_OK) {
+        oct_close(f);
+        return rc;
+    }
+    *out = f;
+    return OCT_OK;
+}
+
+oct_err oct_open(const char *path, unsigned flags, oct_file **out, uint64_t *err_offset)
+{
+    *out = NULL;
+    if (err_offset)
+        *err_offset = 0;
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below. */
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
+    if (fd < 0)
+        return OCT_EIO;
+    oct_err rc = OCT_OK;
+    struct stat st;
+    if (fstat(fd, &st) != 0) {
+        rc = OCT_EIO;
+        goto fail;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        rc = OCT_ENOTFILE;
+        goto fail;
+    }
+    if (st.st_size == 0) {
+        rc = OCT_ETRUNC; /* mmap of zero bytes is an error */
+        goto fail;
+    }
+    if ((uint64_t)st.st_size > SIZE_MAX) {
+        rc = OCT_ENOMEM;
+        goto fail;
+    }
+    oct_file *f = oct__calloc(1, sizeof *f);
+    if (!f) {
+        rc = OCT_ENOMEM;
+        goto fail;
+    }
+    f->size = (size_t)st.st_size;
+    f->map = mmap(NULL, f->size, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (f->map == MAP_FAILED) {
+        int e = errno;
+        free(f);
+        errno = e;
+        rc = OCT_EIO;
+        goto fail;
+    }
+    f->data = f->map;
+    close(fd);
+    return finish_open(f, flags, out, err_offset);
+fail:;
+    int e = errno;
+    close(fd);
+    errno = e;
+    return rc;
+}
+
+oct_err oct_open_memory(const void *data, size_t size, unsigned flags, oct_file **out,
+                        uint64_t *err_offset)
+{
+    *out = NULL;
+    if (err_offset)
+        *err_offset = 0;
+    if (!data && size)
+        return OCT_EUSAGE;
+    oct_file *f = oct__calloc(1, sizeof *f);
+    if (!f)
+        return OCT_ENOMEM;
+    f->size = size;
+    f->data = data ? data : (const unsigned char *)"";
+    if ((uintptr_t)data % 8 != 0) { /* the view casts to uint64_t-bearing structs */
+        f->owned = oct__aligned_alloc(OCT_ALIGN, oct_align_up(size ? size : 1));
+        if (!f->owned) {
+            free(f);
+            return OCT_ENOMEM;
+        }
+        memcpy(f->owned, data, size);
+        f->data = f->owned;
+    }
+    return finish_open(f, flags, out, err_offset);
+}
+
+void oct_close(oct_file *f)
+{
+    if (!f)
+        return;
+    if (f->map)
+        munmap(f->map, f->size);
+    free(f->owned);
+    free(f);
+}
+
+const oct_tree *oct_get_tree(const oct_file *f) { return &f->tree; }
+const oct_info *oct_get_info(const oct_file *f) { return &f->info; }
+
+int oct_print_info(void *out_file, const oct_file *f)
+{
+    FILE *out = out_file;
+    const oct_tree *t = &f->tree;
+    const oct_info *in = &f->info;
+    fprintf(out, "format:      .oct %u.%u\n", in->version_major, in->version_minor);
+    fprintf(out, "levels:      %u (%llu voxels a side)\n", t->levels,
+            (unsigned long long)(UINT64_C(1) << t->levels));
+    fprintf(out, "cube:        origin (%.17g, %.17g, %.17g), edge %.17g\n", t->origin[0], t->origin[1],
+            t->origin[2], t->edge);
+    if (in->root_depth > 0)
+        fprintf(out, "subtree:     depth %u, cell (%llu, %llu, %llu) of the grid at (%.17g, %.17g, %.17g), edge %.17g\n",
+                in->root_depth, (unsigned long long)in->root_cell[0],
+                (unsigned long long)in->root_cell[1], (unsigned long long)in->root_cell[2],
+                in->grid_origin[0], in->grid_origin[1], in->grid_origin[2], in->grid_edge);
+    fprintf(out, "nodes:       %llu\n", (unsigned long long)in->total_nodes);
+    for (uint32_t d = 0; d < t->levels; d++)
+        fprintf(out, "  depth %2u:  %llu\n", d, (unsigned long long)t->node_count[d]);
+    fprintf(out, "voxels:      %llu\n", (unsigned long long)t->voxel_count);
+    fprintf(out, "surfaces:    %u\n", t->surface_count);
+    fprintf(out, "file bytes:  %llu\n", (unsigned long long)in->file_size);
+    if (t->voxel_count)
+        fprintf(out, "bytes/voxel: %.3f\n", (double)in->file_size / (double)t->voxel_count);
+    else
+        fprintf(out, "bytes/voxel: - (no voxels)\n");
+    return ferror(out) ? -1 : 0;
+}

@@ -1,0 +1,329 @@
+/* oct_write: the streaming .oct writer — per-depth buffers of masks, then one
+ * deterministic serialization (bases and CRCs computed at finish). */
+#include "format/oct.h"
+#include "format/oct_layout.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <zlib.h>
+
+struct oct_writer {
+    oct_writer_params p;
+    float palette[OCT_MAX_SURFACES * 3];
+    uint8_t *masks[OCT_MAX_LEVELS];
+    size_t count[OCT_MAX_LEVELS], cap[OCT_MAX_LEVELS];
+    uint32_t *voxels;
+    uint8_t *surfaces;
+    size_t voxel_count, voxel_cap;
+    int done; /* finish was called: the writer accepts nothing more */
+};
+
+/* Everything written goes through a sink: it always updates the running
+ * CRC-32 and writes to `f` when there is one. */
+typedef struct sink {
+    FILE *f;
+    uLong crc;
+    uint64_t bytes;
+} sink;
+
+static int put(sink *s, const void *data, size_t n)
+{
+    if (n == 0)
+        return 0;
+    s->crc = crc32_z(s->crc, data, n);
+    s->bytes += n;
+    /* glibc may report a failed flush inside fwrite only through the error
+     * flag, so both are checked: the writer stops at the first failure. */
+    if (s->f && (fwrite(data, 1, n, s->f) != n || ferror(s->f))) {
+        if (errno == 0)
+            errno = EIO;
+        return -1;
+    }
+    return 0;
+}
+
+static int pad_to(sink *s, uint64_t target)
+{
+    static const unsigned char zero[OCT_ALIGN];
+    while (s->bytes < target) {
+        uint64_t n = target - s->bytes;
+        if (put(s, zero, n < sizeof zero ? (size_t)n : sizeof zero) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int grow(void **buf, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = *cap ? *cap : 4096;
+    while (c < need) {
+        if (c > SIZE_MAX / 2 / elem)
+            return -1;
+        c *= 2;
+    }
+    void *p = oct__realloc(*buf, c * elem);
+    if (!p)
+        return -1;
+    *buf = p;
+    *cap = c;
+    return 0;
+}
+
+static int finite_unit(float v) { return isfinite(v) && v >= 0.0f && v <= 1.0f; }
+
+oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out)
+{
+    *out = NULL;
+    if (!p || p->levels < 1 || p->levels > OCT_MAX_LEVELS || !isfinite(p->edge) || !(p->edge > 0.0) ||
+        p->root_depth > OCT_MAX_ROOT_DEPTH || p->surface_count < 1 ||
+        p->surface_count > OCT_MAX_SURFACES)
+        return OCT_EUSAGE;
+    for (int i = 0; i < 3; i++) {
+        if (!isfinite(p->origin[i]) || p->root_cell[i] >= (UINT64_C(1) << p->root_depth))
+            return OCT_EUSAGE;
+    }
+    double grid_edge = ldexp(p->edge, (int)p->root_depth);
+    for (int i = 0; i < 3; i++) {
+        if (!oct_cube_ok(p->origin[i] - (double)p->root_cell[i] * p->edge, grid_edge, p->root_depth, p->levels))
+            return OCT_EUSAGE; /* the reader would refuse the cube */
+    }
+    for (uint32_t i = 0; p->palette && i < 3 * p->surface_count; i++) {
+        if (!finite_unit(p->palette[i]))
+            return OCT_EUSAGE;
+    }
+    oct_writer *w = oct__calloc(1, sizeof *w);
+    if (!w)
+        return OCT_ENOMEM;
+    w->p = *p;
+    for (uint32_t i = 0; i < 3 * p->surface_count; i++)
+        w->palette[i] = p->palette ? p->palette[i] : 0.8f;
+    w->p.palette = w->palette;
+    *out = w;
+    return OCT_OK;
+}
+
+oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks, size_t n)
+{
+    if (!w || w->done || depth >= w->p.levels || (n && !masks))
+        return OCT_EUSAGE;
+    for (size_t i = 0; i < n; i++) {
+        if (masks[i] == 0)
+            return OCT_EUSAGE; /* only non-empty nodes are stored */
+    }
+    if (n > SIZE_MAX - w->count[depth])
+        return OCT_ENOMEM;
+    void *buf = w->masks[depth];
+    if (grow(&buf, &w->cap[depth], w->count[depth] + n, 1) != 0)
+        return OCT_ENOMEM;
+    w->masks[depth] = buf;
+    if (n)
+        memcpy(w->masks[depth] + w->count[depth], masks, n);
+    w->count[depth] += n;
+    return OCT_OK;
+}
+
+oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8_t *surfaces, size_t n)
+{
+    if (!w || w->done || (n && !voxels) || (n && w->p.surface_count > 1 && !surfaces))
+        return OCT_EUSAGE;
+    for (size_t i = 0; i < n; i++) {
+        if ((voxels[i] >> OCT_VOXEL_OFFSET_SHIFT) == 0x80u)
+            return OCT_EUSAGE; /* offset -128 is reserved */
+        if (w->p.surface_count > 1 && surfaces[i] >= w->p.surface_count)
+            return OCT_EUSAGE;
+    }
+    if (n > SIZE_MAX - w->voxel_count)
+        return OCT_ENOMEM;
+    size_t need = w->voxel_count + n, cap = w->voxel_cap;
+    void *v = w->voxels;
+    if (grow(&v, &cap, need, sizeof(uint32_t)) != 0)
+        return OCT_ENOMEM;
+    w->voxels = v;
+    if (w->p.surface_count > 1 && cap != w->voxel_cap) {
+        uint8_t *s = oct__realloc(w->surfaces, cap);
+        if (!s)
+            return OCT_ENOMEM; /* voxel_cap unchanged: the next call retries */
+        w->surfaces = s;
+    }
+    w->voxel_cap = cap;
+    if (n) {
+        memcpy(w->voxels + w->voxel_count, voxels, n * sizeof *voxels);
+        if (w->p.surface_count > 1)
+            memcpy(w->surfaces + w->voxel_count, surfaces, n);
+    }
+    w->voxel_count = need;
+    return OCT_OK;
+}
+
+static uint64_t groups_of(uint64_t nodes) { return nodes / 8 + (nodes % 8 != 0); }
+
+/* Streams the node section (every depth's groups, depth 0 first). */
+static int put_nodes(const oct_writer *w, sink *s)
+{
+    enum { CHUNK = 4096 };
+    unsigned char buf[CHUNK * 16];
+    for (uint32_t d = 0; d < w->p.levels; d++) {
+        uint64_t base = 0, n = w->count[d];
+        size_t fill = 0;
+        for (uint64_t g = 0; g < groups_of(n); g++) {
+            unsigned char *rec = buf + 16 * fill;
+            wr_u64le(rec, base);
+            for (unsigned k = 0; k < 8; k++) {
+                uint64_t i = 8 * g + k;
+                rec[8 + k] = i < n ? w->masks[d][i] : 0;
+                base += oct_popcount64(rec[8 + k]);
+            }
+            if (++fill == CHUNK) {
+                if (put(s, buf, sizeof buf) != 0)
+                    return -1;
+                fill = 0;
+            }
+        }
+        if (put(s, buf, 16 * fill) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+typedef struct layout {
+    uint64_t off[OCT_SEC_COUNT], size[OCT_SEC_COUNT];
+    uint32_t crc[OCT_SEC_COUNT];
+    uint64_t file_size;
+} layout;
+
+/* Writes (s->f != NULL) or checksums (s->f == NULL) section k. */
+static int put_section(const oct_writer *w, int k, sink *s)
+{
+    switch (k) {
+    case OCT_SEC_LEVELS:
+        for (uint32_t d = 0; d < w->p.levels; d++) {
+            unsigned char b[8];
+            wr_u64le(b, w->count[d]);
+            if (put(s, b, 8) != 0)
+                return -1;
+        }
+        return 0;
+    case OCT_SEC_NODES:
+        return put_nodes(w, s);
+    case OCT_SEC_VOXELS:
+        return put(s, w->voxels, w->voxel_count * sizeof(uint32_t)); /* little-endian host */
+    case OCT_SEC_SURFACES:
+        return w->p.surface_count > 1 ? put(s, w->surfaces, w->voxel_count) : 0;
+    default:
+        return put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
+    }
+}
+
+static void build_header(const oct_writer *w, const layout *lay, unsigned char *h)
+{
+    const oct_writer_params *p = &w->p;
+    memset(h, 0, OCT_HEADER_SIZE);
+    memcpy(h + OCT_OFF_MAGIC, OCT_MAGIC, OCT_MAGIC_SIZE);
+    wr_u16le(h + OCT_OFF_MAJOR, OCT_VERSION_MAJOR);
+    wr_u16le(h + OCT_OFF_MINOR, OCT_VERSION_MINOR);
+    wr_u32le(h + OCT_OFF_HEADER_SIZE, OCT_HEADER_SIZE);
+    wr_u32le(h + OCT_OFF_BOM_U32, OCT_BOM_U32);
+    wr_f64le(h + OCT_OFF_BOM_F64, OCT_BOM_F64);
+    wr_u32le(h + OCT_OFF_LEVELS, p->levels);
+    wr_u32le(h + OCT_OFF_ROOT_DEPTH, p->root_depth);
+    for (int i = 0; i < 3; i++) {
+        wr_u64le(h + OCT_OFF_ROOT_CELL + 8 * i, p->root_cell[i]);
+        /* The grid's corner; the reader derives this tree's corner back from
+         * it (exactly so for a whole grid, root_cell = 0). */
+        wr_f64le(h + OCT_OFF_GRID_ORIGIN + 8 * i, p->origin[i] - (double)p->root_cell[i] * p->edge);
+    }
+    wr_f64le(h + OCT_OFF_GRID_EDGE, ldexp(p->edge, (int)p->root_depth));
+    wr_u32le(h + OCT_OFF_SURFACE_COUNT, p->surface_count);
+    wr_u64le(h + OCT_OFF_VOXEL_COUNT, w->voxel_count);
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        wr_u64le(h + OCT_SEC_OFF(k), lay->off[k]);
+        wr_u64le(h + OCT_SEC_OFF(k) + 8, lay->size[k]);
+        wr_u32le(h + OCT_SEC_OFF(k) + 16, lay->crc[k]);
+    }
+    wr_u32le(h + OCT_OFF_HEADER_CRC, (uint32_t)crc32_z(0, h, OCT_OFF_HEADER_CRC));
+}
+
+oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written)
+{
+    FILE *f = out_file;
+    if (bytes_written)
+        *bytes_written = 0;
+    if (!w || w->done || !f)
+        return OCT_EUSAGE;
+    w->done = 1;
+    const uint32_t L = w->p.levels;
+    if (w->count[0] > 1)
+        return OCT_EUSAGE;
+    for (uint32_t d = 0; d < L; d++) {
+        uint64_t children = 0;
+        for (size_t i = 0; i < w->count[d]; i++)
+            children += oct_popcount64(w->masks[d][i]);
+        uint64_t want = d + 1 < L ? w->count[d + 1] : w->voxel_count;
+        if (children != want)
+            return OCT_EUSAGE;
+    }
+    if (L > 1 && w->count[0] == 0 && w->voxel_count != 0)
+        return OCT_EUSAGE;
+
+    layout lay = {0};
+    uint64_t end = OCT_HEADER_SIZE;
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        uint64_t size;
+        switch (k) {
+        case OCT_SEC_LEVELS: size = 8u * L; break;
+        case OCT_SEC_NODES:
+            size = 0;
+            for (uint32_t d = 0; d < L; d++)
+                size += 16 * groups_of(w->count[d]);
+            break;
+        case OCT_SEC_VOXELS: size = 4 * (uint64_t)w->voxel_count; break;
+        case OCT_SEC_SURFACES: size = w->p.surface_count > 1 ? w->voxel_count : 0; break;
+        default: size = 12u * w->p.surface_count; break;
+        }
+        lay.size[k] = size;
+        if (size) {
+            lay.off[k] = oct_align_up(end);
+            end = lay.off[k] + size;
+        }
+        sink crc = {NULL, crc32_z(0, NULL, 0), 0};
+        put_section(w, k, &crc);
+        lay.crc[k] = (uint32_t)crc.crc;
+    }
+    lay.file_size = end;
+
+    unsigned char h[OCT_HEADER_SIZE];
+    build_header(w, &lay, h);
+    sink s = {f, 0, 0};
+    errno = 0;
+    if (put(&s, h, sizeof h) != 0)
+        return OCT_EIO;
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        if (lay.size[k] == 0)
+            continue;
+        if (pad_to(&s, lay.off[k]) != 0 || put_section(w, k, &s) != 0)
+            return OCT_EIO;
+    }
+    if (fflush(f) != 0 || ferror(f)) {
+        if (errno == 0)
+            errno = EIO;
+        return OCT_EIO;
+    }
+    if (bytes_written)
+        *bytes_written = s.bytes;
+    return OCT_OK;
+}
+
+void oct_writer_free(oct_writer *w)
+{
+    if (!w)
+        return;
+    for (int d = 0; d < OCT_MAX_LEVELS; d++)
+        free(w->masks[d]);
+    free(w->voxels);
+    free(w->surfaces);
+    free(w);
+}

@@ -1,0 +1,541 @@
+/* Tests for common/tape: point evaluation of every scene against
+ * hand-written C, gradients against central differences, interval and
+ * interval-gradient enclosures on the scenes and on random expression
+ * trees, and pruning. Run from the repository root (reads scenes/). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/scene.h"
+#include "common/tape.h"
+
+#ifdef __FAST_MATH__
+#error "fast-math breaks the interval arithmetic; build without it"
+#endif
+
+#if defined(__SANITIZE_ADDRESS__)
+#define SCALE 10
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SCALE 10
+#endif
+#endif
+#ifndef SCALE
+#define SCALE 1
+#endif
+
+#define MAXSLOTS 4096
+
+static uint64_t rng = 0x2545f4914f6cdd1dull;
+static uint64_t next_u64(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return rng;
+}
+static double unit(void) { return (double)(next_u64() >> 11) * 0x1p-53; }
+
+/* ---- the scenes in plain C ---------------------------------------------- */
+
+static double sq(double v) { return v * v; }
+static double r2(double x, double y, double z, double a, double b, double c)
+{
+    return sq(x - a) + sq(y - b) + sq(z - c);
+}
+static double mn(double a, double b) { return a < b ? a : b; }
+static double mx(double a, double b) { return a > b ? a : b; }
+
+static double f_blobs_a(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2];
+    return exp(-3.25 * r2(x, y, z, 0.78, 0.78, 0.78)) + exp(-3.25 * r2(x, y, z, 0.23, 0.23, 0.23)) - 0.9;
+}
+static double f_blobs_b(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2];
+    return exp(-196 * (sq(sq(x - 0.23)) + sq(sq(y - 0.23)) + sq(sq(z - 0.68)))) +
+           exp(-196 * (sq(sq(x - 0.68)) + sq(sq(y - 0.68)) + sq(sq(z - 0.23)))) +
+           exp(-7 * r2(x, y, z, 0.68, 0.68, 0.68)) + exp(-7 * r2(x, y, z, 0.23, 0.23, 0.23)) - 0.9;
+}
+static double f_sphere(const double *p, int s)
+{
+    (void)s;
+    return sq(p[0]) + sq(p[1]) + sq(p[2]) - 1;
+}
+static double f_torus(const double *p, int s)
+{
+    (void)s;
+    return sq(sqrt(sq(p[0]) + sq(p[1])) - 1) + sq(p[2]) - sq(0.3);
+}
+static double f_csg(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2];
+    double cube = mx(mx(fabs(x), fabs(y)), fabs(z)) - 0.8;
+    double ball = sq(x) + sq(y) + sq(z) - 1.0;
+    double cyl = 0.16 - mn(mn(sq(x) + sq(y), sq(y) + sq(z)), sq(z) + sq(x));
+    return mx(mx(cube, ball), cyl);
+}
+static double f_gyroid(const double *p, int s)
+{
+    (void)s;
+    double k = 3 * M_PI, x = p[0], y = p[1], z = p[2];
+    double g = sin(k * x) * cos(k * y) + sin(k * y) * cos(k * z) + sin(k * z) * cos(k * x);
+    return mx(fabs(g) - 0.3, sq(x) + sq(y) + sq(z) - 1);
+}
+static double f_barth(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2], ph = (1 + sqrt(5)) / 2, p2 = sq(ph);
+    double f = 4 * (p2 * sq(x) - sq(y)) * (p2 * sq(y) - sq(z)) * (p2 * sq(z) - sq(x)) -
+               (1 + 2 * ph) * sq(sq(x) + sq(y) + sq(z) - 1);
+    return mx(f, sq(x) + sq(y) + sq(z) - sq(1.6));
+}
+static double f_thin(const double *p, int s)
+{
+    double x = p[0], y = p[1], z = p[2];
+    if (s == 0)
+        return mx(fabs(z - 0.1) - 0.001, sq(x) + sq(y) - 0.64);
+    return mx(fabs(sqrt(sq(x) + sq(y) + sq(z)) - 0.5) - 0.0015, -z - 0.2);
+}
+static double f_multi(const double *p, int s)
+{
+    double x = p[0], y = p[1], z = p[2];
+    if (s == 0)
+        return sq(x + 1.2) + sq(y) + sq(z) - sq(0.6);
+    if (s == 1)
+        return sq(sqrt(sq(x) + sq(z)) - 0.55) + sq(y) - sq(0.18);
+    return sq(sq(x - 1.25)) + sq(sq(y)) + sq(sq(z)) - sq(sq(0.55));
+}
+static const double blob_c[20][3] = {
+    {0.394, 0.291, 0.591}, {0.243, 0.522, 0.419}, {0.235, 0.504, 0.222}, {0.46, 0.242, 0.254},
+    {0.455, 0.696, 0.274}, {0.334, 0.576, 0.769}, {0.546, 0.438, 0.786}, {0.228, 0.715, 0.374},
+    {0.287, 0.271, 0.385}, {0.69, 0.308, 0.549},  {0.583, 0.423, 0.529}, {0.238, 0.236, 0.324},
+    {0.608, 0.457, 0.388}, {0.551, 0.472, 0.38},  {0.677, 0.619, 0.346}, {0.545, 0.515, 0.725},
+    {0.638, 0.373, 0.788}, {0.271, 0.451, 0.654}, {0.291, 0.493, 0.224}, {0.601, 0.659, 0.544}};
+static double f_manyblobs(const double *p, int s)
+{
+    (void)s;
+    double v = 0;
+    for (int i = 0; i < 20; i++)
+        v += exp(-40 * r2(p[0], p[1], p[2], blob_c[i][0], blob_c[i][1], blob_c[i][2]));
+    return v - 0.5;
+}
+
+static const struct {
+    const char *path;
+    double (*f)(const double *p, int surface);
+    int nsurf;
+} scenes[] = {
+    {"scenes/blobs_a.scene", f_blobs_a, 1}, {"scenes/blobs_b.scene", f_blobs_b, 1},
+    {"scenes/sphere.scene", f_sphere, 1},   {"scenes/torus.scene", f_torus, 1},
+    {"scenes/csg.scene", f_csg, 1},         {"scenes/gyroid.scene", f_gyroid, 1},
+    {"scenes/barth.scene", f_barth, 1},     {"scenes/thin.scene", f_thin, 2},
+    {"scenes/multi.scene", f_multi, 3},     {"scenes/manyblobs.scene", f_manyblobs, 1},
+};
+#define NSCENES (sizeof scenes / sizeof scenes[0])
+
+static scene *load(const char *path)
+{
+    scene *s = NULL;
+    scene_error e;
+    if (scene_load(path, &s, &e) != 0)
+        fail_msg("%s:%u:%u: %s", path, e.line, e.col, e.message);
+    assert_true(s->nsurfaces >= 1);
+    for (size_t i = 0; i < s->nsurfaces; i++)
+        assert_true(s->surfaces[i].tape.n <= MAXSLOTS);
+    return s;
+}
+
+static void rand_point(const scene *s, double p[3])
+{
+    for (int a = 0; a < 3; a++)
+        p[a] = s->lo[a] + unit() * (s->hi[a] - s->lo[a]);
+}
+
+static void test_scene_files_all_listed(void **state)
+{
+    (void)state;
+    /* There are at least ten scenes, and each one is checked here. */
+    FILE *ls = popen("ls scenes/*.scene | wc -l", "r");
+    assert_non_null(ls);
+    int n = 0;
+    assert_int_equal(fscanf(ls, "%d", &n), 1);
+    pclose(ls);
+    assert_true(n >= 10);
+    assert_int_equal((size_t)n, NSCENES);
+}
+
+static void test_point_vs_c(void **state)
+{
+    (void)state;
+    double slots[MAXSLOTS];
+    for (size_t k = 0; k < NSCENES; k++) {
+        scene *s = load(scenes[k].path);
+        assert_int_equal(s->nsurfaces, scenes[k].nsurf);
+        for (int i = 0; i < 10000; i++) {
+            double p[3];
+            rand_point(s, p);
+            for (size_t j = 0; j < s->nsurfaces; j++) {
+                double v = tape_eval(&s->surfaces[j].tape, p[0], p[1], p[2], slots);
+                double w = scenes[k].f(p, (int)j);
+                if (!(fabs(v - w) <= 1e-12 * (1 + fabs(w))))
+                    fail_msg("%s surface %zu at (%g,%g,%g): tape %.17g, C %.17g", scenes[k].path, j,
+                             p[0], p[1], p[2], v, w);
+            }
+        }
+        scene_free(s);
+    }
+}
+
+/* Each surface lies inside its bounds: f has one sign, never 0, on a grid
+ * over the faces of the bounds box. */
+static void test_surfaces_inside_bounds(void **state)
+{
+    (void)state;
+    double slots[MAXSLOTS];
+    for (size_t k = 0; k < NSCENES; k++) {
+        scene *s = load(scenes[k].path);
+        for (size_t j = 0; j < s->nsurfaces; j++) {
+            int sign = 0;
+            for (int face = 0; face < 6; face++)
+                for (int u = 0; u <= 40; u++)
+                    for (int v = 0; v <= 40; v++) {
+                        double p[3];
+                        int a = face % 3, b = (a + 1) % 3, c = (a + 2) % 3;
+                        p[a] = face < 3 ? s->lo[a] : s->hi[a];
+                        p[b] = s->lo[b] + (s->hi[b] - s->lo[b]) * u / 40;
+                        p[c] = s->lo[c] + (s->hi[c] - s->lo[c]) * v / 40;
+                        double f = tape_eval(&s->surfaces[j].tape, p[0], p[1], p[2], slots);
+                        int sg = f > 0 ? 1 : f < 0 ? -1 : 0;
+                        if (sg == 0 || (sign && sg != sign))
+                            fail_msg("%s surface %zu crosses its bounds at (%g,%g,%g)",
+                                     scenes[k].path, j, p[0], p[1], p[2]);
+                        sign = sg;
+                    }
+            /* ... and it is not empty: some sample inside has the other sign. */
+            int found = 0;
+            for (int i = 0; i < 200000 && !found; i++) {
+                double p[3];
+                rand_point(s, p);
+                double f = tape_eval(&s->surfaces[j].tape, p[0], p[1], p[2], slots);
+                found = (f > 0 ? 1 : -1) != sign;
+            }
+            if (!found && strstr(scenes[k].path, "thin") == NULL)
+                fail_msg("%s surface %zu: no interior sample found", scenes[k].path, j);
+        }
+        scene_free(s);
+    }
+}
+
+static void test_gradient_vs_differences(void **state)
+{
+    (void)state;
+    tape_dual duals[MAXSLOTS];
+    double slots[MAXSLOTS];
+    for (size_t k = 0; k < NSCENES; k++) {
+        scene *s = load(scenes[k].path);
+        for (size_t j = 0; j < s->nsurfaces; j++) {
+            const tape *t = &s->surfaces[j].tape;
+            int tried = 0, skipped = 0;
+            for (int i = 0; i < 2000; i++) {
+                double p[3], g[3];
+                rand_point(s, p);
+                double v = tape_eval_grad(t, p, g, duals);
+                assert_true(v == tape_eval(t, p[0], p[1], p[2], slots));
+                double gn = fabs(g[0]) + fabs(g[1]) + fabs(g[2]);
+                tried++;
+                for (int a = 0; a < 3; a++) {
+                    double fd[2];
+                    for (int r = 0; r < 2; r++) {
+                        double h = r == 0 ? 1e-5 : 5e-6, q[3] = {p[0], p[1], p[2]}, f1, f0;
+                        q[a] = p[a] + h;
+                        f1 = tape_eval(t, q[0], q[1], q[2], slots);
+                        q[a] = p[a] - h;
+                        f0 = tape_eval(t, q[0], q[1], q[2], slots);
+                        fd[r] = (f1 - f0) / (2 * h);
+                    }
+                    double tol = 1e-6 * (gn + 1);
+                    if (fabs(fd[0] - fd[1]) > tol) { /* a kink nearby: not smooth here */
+                        skipped++;
+                        break;
+                    }
+                    if (!(fabs(g[a] - fd[1]) <= tol))
+                        fail_msg("%s: d/d%c at (%g,%g,%g): AD %.12g, differences %.12g",
+                                 scenes[k].path, 'x' + a, p[0], p[1], p[2], g[a], fd[1]);
+                }
+            }
+            assert_true(skipped < tried / 10);
+        }
+        scene_free(s);
+    }
+}
+
+/* v is enclosed by r (with the flag rules of interval.h). */
+static int encloses(interval r, unsigned flags, double v)
+{
+    if (interval_is_nan(r))
+        return flags != 0;
+    if (isnan(v))
+        return flags != 0;
+    return r.lo <= v && v <= r.hi;
+}
+
+static double in_box(interval b)
+{
+    double p = b.lo + unit() * (b.hi - b.lo);
+    return p < b.lo ? b.lo : p > b.hi ? b.hi : p;
+}
+
+static void rand_box(const scene *s, interval box[3])
+{
+    double w = ldexp(1.0, -(int)(next_u64() % 24));
+    for (int a = 0; a < 3; a++) {
+        double len = (s->hi[a] - s->lo[a]) * w;
+        double lo = s->lo[a] + unit() * (s->hi[a] - s->lo[a] - len);
+        box[a].lo = lo;
+        box[a].hi = next_u64() % 16 == 0 ? lo : lo + len;
+    }
+}
+
+static void test_interval_scenes(void **state)
+{
+    (void)state;
+    static interval slots[MAXSLOTS];
+    static tape_idual islots[MAXSLOTS];
+    static tape_dual duals[MAXSLOTS];
+    double dslots[MAXSLOTS];
+    for (size_t k = 0; k < NSCENES; k++) {
+        scene *s = load(scenes[k].path);
+        const int nbox = 100000 / SCALE / (int)s->nsurfaces;
+        for (size_t j = 0; j < s->nsurfaces; j++) {
+            const tape *t = &s->surfaces[j].tape;
+            for (int i = 0; i < nbox; i++) {
+                interval box[3];
+                rand_box(s, box);
+                unsigned f;
+                interval r = tape_eval_interval(t, box, slots, &f);
+                int do_grad = i % 8 == 0;
+                interval ig[3];
+                unsigned gf = 0;
+                if (do_grad) {
+                    interval r2 = tape_eval_interval_grad(t, box, ig, islots, &gf);
+                    assert_true(r2.lo == r.lo && r2.hi == r.hi);
+                }
+                for (int w = 0; w < 4; w++) {
+                    double p[3] = {in_box(box[0]), in_box(box[1]), in_box(box[2])};
+                    double v = tape_eval(t, p[0], p[1], p[2], dslots);
+                    if (!encloses(r, f, v))
+                        fail_msg("%s: f(%a,%a,%a) = %a outside [%a, %a]", scenes[k].path, p[0], p[1],
+                                 p[2], v, r.lo, r.hi);
+                    if (do_grad && !gf) {
+                        double g[3];
+                        tape_eval_grad(t, p, g, duals);
+                        for (int a = 0; a < 3; a++)
+                            if (!encloses(ig[a], gf, g[a]))
+                                fail_msg("%s: df/d%c = %a outside [%a, %a]", scenes[k].path,
+                                         'x' + a, g[a], ig[a].lo, ig[a].hi);
+                    }
+                }
+            }
+        }
+        scene_free(s);
+    }
+}
+
+/* ---- random expression trees --------------------------------------------- */
+
+static void gen(char **p, char *end, int depth)
+{
+    static const char *leaves[] = {"x", "y", "z", "0.78", "pi", "e", "2", "1.5", "0.5", "3", "0.1"};
+    static const char *un[] = {"exp", "log", "sqrt", "abs", "sin", "cos", "tan", "-"};
+    static const char *bin[] = {"+", "-", "*", "/", "min", "max", "^", "pow"};
+    if (end - *p < 200) {
+        *p += sprintf(*p, "x");
+        return;
+    }
+    uint64_t r = next_u64() % 10;
+    if (depth == 0 || r < 2) {
+        *p += sprintf(*p, "%s", leaves[next_u64() % (sizeof leaves / sizeof leaves[0])]);
+        return;
+    }
+    if (r < 5) {
+        const char *u = un[next_u64() % (sizeof un / sizeof un[0])];
+        *p += sprintf(*p, u[0] == '-' ? "-(" : "%s(", u);
+        gen(p, end, depth - 1);
+        *p += sprintf(*p, ")");
+        return;
+    }
+    const char *b = bin[next_u64() % (sizeof bin / sizeof bin[0])];
+    if (b[0] == '^') {
+        static const char *ex[] = {"2", "3", "4", "-1", "-2", "0.5", "1.5", "y", "5"};
+        *p += sprintf(*p, "(");
+        gen(p, end, depth - 1);
+        *p += sprintf(*p, ")^%s", ex[next_u64() % (sizeof ex / sizeof ex[0])]);
+    } else if (b[0] >= 'a') {
+        *p += sprintf(*p, "%s(", b);
+        gen(p, end, depth - 1);
+        *p += sprintf(*p, ", ");
+        gen(p, end, depth - 1);
+        if (b[1] != 'o' && next_u64() % 3 == 0) {
+            *p += sprintf(*p, ", ");
+            gen(p, end, depth - 1);
+        }
+        *p += sprintf(*p, ")");
+    } else {
+        *p += sprintf(*p, "(");
+        gen(p, end, depth - 1);
+        *p += sprintf(*p, ") %s (", b);
+        gen(p, end, depth - 1);
+        *p += sprintf(*p, ")");
+    }
+}
+
+/* A random scene whose surface is a random tree of depth <= 6. */
+static scene *rand_tree(char *text, size_t n)
+{
+    for (;;) {
+        char *p = text + sprintf(text, "bounds -4 -4 -4 4 4 4\nsurface ");
+        gen(&p, text + n, 1 + (int)(next_u64() % 6));
+        *p++ = '\n';
+        scene *s = NULL;
+        scene_error e;
+        if (scene_parse(text, (size_t)(p - text), &s, &e) == 0)
+            return s;
+        /* Only constant sub-trees that are undefined may be refused. */
+        if (!strstr(e.message, "constant expression") && !strstr(e.message, "exponent"))
+            fail_msg("%s: %s", text, e.message);
+    }
+}
+
+static void rand_tree_box(interval box[3])
+{
+    for (int a = 0; a < 3; a++) {
+        double c = (unit() - 0.5) * 8, w = 8 * ldexp(unit(), -(int)(next_u64() % 30));
+        box[a].lo = c;
+        box[a].hi = next_u64() % 10 == 0 ? c : c + w;
+    }
+}
+
+static void test_random_trees(void **state)
+{
+    (void)state;
+    static char text[16384];
+    static interval slots[MAXSLOTS];
+    static tape_insn pruned_insn[MAXSLOTS];
+    static uint32_t scratch[MAXSLOTS];
+    double d1[MAXSLOTS], d2[MAXSLOTS];
+    long points = 0, pruned_shorter = 0;
+    for (int n = 0; n < 3000 / SCALE; n++) {
+        scene *s = rand_tree(text, sizeof text);
+        const tape *t = &s->surfaces[0].tape;
+        for (int b = 0; b < 30; b++) {
+            interval box[3];
+            rand_tree_box(box);
+            unsigned f;
+            interval r = tape_eval_interval(t, box, slots, &f);
+            tape pt;
+            uint32_t len = tape_prune(t, slots, f, pruned_insn, scratch, &pt);
+            assert_true(len <= t->n && len >= 1);
+            pruned_shorter += len < t->n;
+            for (int w = 0; w < 10; w++) {
+                double p[3] = {in_box(box[0]), in_box(box[1]), in_box(box[2])};
+                double v = tape_eval(t, p[0], p[1], p[2], d1);
+                points++;
+                if (!encloses(r, f, v))
+                    fail_msg("%s box [%a,%a]x[%a,%a]x[%a,%a]: f(%a,%a,%a) = %a outside [%a, %a] "
+                             "(flags %u)", text, box[0].lo, box[0].hi, box[1].lo, box[1].hi,
+                             box[2].lo, box[2].hi, p[0], p[1], p[2], v, r.lo, r.hi, f);
+                double pv = tape_eval(&pt, p[0], p[1], p[2], d2);
+                if (!(pv == v || (isnan(pv) && isnan(v))))
+                    fail_msg("%s: pruned %.17g, full %.17g", text, pv, v);
+            }
+        }
+        scene_free(s);
+    }
+    assert_true(points > 0);
+    assert_true(pruned_shorter > 0);
+}
+
+static void test_prune(void **state)
+{
+    (void)state;
+    static const char text[] = "bounds 0 0 0 1 1 1\nsurface min(x, y + 10, max(z, z^2 - 5)) + sin(x)\n";
+    scene *s = NULL;
+    scene_error e;
+    assert_int_equal(scene_parse(text, sizeof text - 1, &s, &e), 0);
+    const tape *t = &s->surfaces[0].tape;
+    interval slots[64], box[3] = {{0, 1}, {0, 1}, {0, 1}};
+    tape_insn out[64];
+    uint32_t scratch[64];
+    unsigned f;
+    tape_eval_interval(t, box, slots, &f);
+    tape pt;
+    uint32_t n = tape_prune(t, slots, f, out, scratch, &pt);
+    /* min(min(x, y+10), max(z, z^2-5)) becomes min(x, z): x, z, min, sin, add. */
+    assert_true(t->n > 9);
+    assert_int_equal(n, 5);
+    double d[64];
+    assert_true(tape_eval(&pt, 0.5, 0.2, 0.3, d) == 0.3 + sin(0.5));
+    /* Pruning a pruned tape again is fine, and NULL slots only drop dead code. */
+    tape_insn out2[64];
+    tape pt2;
+    assert_int_equal(tape_prune(&pt, NULL, 0, out2, scratch, &pt2), 5);
+    /* On a box where the operands overlap nothing is dropped. */
+    interval wide[3] = {{-20, 20}, {-20, 20}, {-20, 20}};
+    tape_eval_interval(t, wide, slots, &f);
+    assert_int_equal(tape_prune(t, slots, f, out, scratch, &pt), t->n);
+    scene_free(s);
+}
+
+/* Documented rules for undefined points (TESTPLAN 23, 24). */
+static void test_undefined_points(void **state)
+{
+    (void)state;
+    static const char text[] = "bounds -1 -1 -1 1 1 1\nsurface sqrt(x) + log(y) + 1/z\n";
+    scene *s = NULL;
+    scene_error e;
+    assert_int_equal(scene_parse(text, sizeof text - 1, &s, &e), 0);
+    const tape *t = &s->surfaces[0].tape;
+    double d[64];
+    assert_true(tape_eval(t, 0, 1, 1, d) == 1.0);                /* sqrt(0) = 0 */
+    assert_true(tape_eval(t, 1, 0, 1, d) == -INFINITY);          /* log(0) = -inf */
+    assert_true(tape_eval(t, 1, 1, 0, d) == INFINITY);           /* 1/0 = +inf */
+    assert_true(isnan(tape_eval(t, -1, 1, 1, d)));               /* sqrt(-1) */
+    interval slots[64], box[3] = {{0, 0}, {0, 1}, {0, 1}};
+    unsigned f;
+    interval r = tape_eval_interval(t, box, slots, &f);
+    assert_true(r.lo == -INFINITY && r.hi == INFINITY); /* 1/[0,1] */
+    box[0].lo = -1;
+    r = tape_eval_interval(t, box, slots, &f);
+    assert_true(f == INTERVAL_MAYBE_NAN);
+    box[0].hi = -0.5;
+    r = tape_eval_interval(t, box, slots, &f);
+    assert_true(interval_is_nan(r) && f == INTERVAL_MAYBE_NAN);
+    scene_free(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scene_files_all_listed),
+        cmocka_unit_test(test_point_vs_c),
+        cmocka_unit_test(test_surfaces_inside_bounds),
+        cmocka_unit_test(test_gradient_vs_differences),
+        cmocka_unit_test(test_interval_scenes),
+        cmocka_unit_test(test_random_trees),
+        cmocka_unit_test(test_prune),
+        cmocka_unit_test(test_undefined_points),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
