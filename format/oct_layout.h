@@ -5,6 +5,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -69,6 +70,13 @@ static inline int oct_cube_ok(double grid_origin, double grid_edge, uint32_t roo
     return grid_edge > 0.0 && grid_edge <= OCT_MAX_COORD && voxel >= DBL_MIN &&
            fabs(grid_origin) <= OCT_MAX_COORD && fabs(grid_origin) + grid_edge <= voxel / OCT_MIN_VOXEL_RES;
 }
+
+/* Allocation inside format/ (oct_alloc.c). Tests arm a failure of the nth
+ * allocation from now (and, when sticky, of every later one); n = 0 disarms. */
+void *oct__calloc(size_t n, size_t size);
+void *oct__realloc(void *p, size_t size);
+void *oct__aligned_alloc(size_t align, size_t size);
+void oct__alloc_fail_after(long n, int sticky);
 
 static inline uint64_t oct_align_up(uint64_t v) { return (v + (OCT_ALIGN - 1)) & ~(uint64_t)(OCT_ALIGN - 1); }
 

@@ -293,7 +293,7 @@ oct_err oct_open(const char *path, unsigned flags, oct_file **out, uint64_t *err
         rc = OCT_ENOMEM;
         goto fail;
     }
-    oct_file *f = calloc(1, sizeof *f);
+    oct_file *f = oct__calloc(1, sizeof *f);
     if (!f) {
         rc = OCT_ENOMEM;
         goto fail;
@@ -325,13 +325,13 @@ oct_err oct_open_memory(const void *data, size_t size, unsigned flags, oct_file 
         *err_offset = 0;
     if (!data && size)
         return OCT_EUSAGE;
-    oct_file *f = calloc(1, sizeof *f);
+    oct_file *f = oct__calloc(1, sizeof *f);
     if (!f)
         return OCT_ENOMEM;
     f->size = size;
     f->data = data ? data : (const unsigned char *)"";
     if ((uintptr_t)data % 8 != 0) { /* the view casts to uint64_t-bearing structs */
-        f->owned = aligned_alloc(OCT_ALIGN, oct_align_up(size ? size : 1));
+        f->owned = oct__aligned_alloc(OCT_ALIGN, oct_align_up(size ? size : 1));
         if (!f->owned) {
             free(f);
             return OCT_ENOMEM;

@@ -34,7 +34,9 @@ static int put(sink *s, const void *data, size_t n)
         return 0;
     s->crc = crc32_z(s->crc, data, n);
     s->bytes += n;
-    if (s->f && fwrite(data, 1, n, s->f) != n) {
+    /* glibc may report a failed flush inside fwrite only through the error
+     * flag, so both are checked: the writer stops at the first failure. */
+    if (s->f && (fwrite(data, 1, n, s->f) != n || ferror(s->f))) {
         if (errno == 0)
             errno = EIO;
         return -1;
@@ -63,7 +65,7 @@ static int grow(void **buf, size_t *cap, size_t need, size_t elem)
             return -1;
         c *= 2;
     }
-    void *p = realloc(*buf, c * elem);
+    void *p = oct__realloc(*buf, c * elem);
     if (!p)
         return -1;
     *buf = p;
@@ -93,7 +95,7 @@ oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out)
         if (!finite_unit(p->palette[i]))
             return OCT_EUSAGE;
     }
-    oct_writer *w = calloc(1, sizeof *w);
+    oct_writer *w = oct__calloc(1, sizeof *w);
     if (!w)
         return OCT_ENOMEM;
     w->p = *p;
@@ -142,7 +144,7 @@ oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8
         return OCT_ENOMEM;
     w->voxels = v;
     if (w->p.surface_count > 1 && cap != w->voxel_cap) {
-        uint8_t *s = realloc(w->surfaces, cap);
+        uint8_t *s = oct__realloc(w->surfaces, cap);
         if (!s)
             return OCT_ENOMEM; /* voxel_cap unchanged: the next call retries */
         w->surfaces = s;
