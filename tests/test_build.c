@@ -221,12 +221,12 @@ static void test_sphere_normals_and_offsets(void **state)
     scene *sc = NULL;
     scene_error err;
     assert_int_equal(scene_parse(text, sizeof text - 1, &sc, &err), 0);
-    unsigned levels = SANITIZED ? 5 : 7, n = 1u << levels;
+    unsigned levels = 7, n = 1u << levels;
     built b;
     build_in_memory(sc, levels, BUILD_INTERVAL, 2, &b);
     const double C[3] = {0.1, -0.05, 0.0}, R = 0.7, h = 2.0 / n;
     double worst_angle = 0.0, worst_offset = 0.0;
-    uint64_t seen = 0;
+    uint64_t seen = 0, outside = 0;
     for (uint64_t z = 0; z < n; z++)
         for (uint64_t y = 0; y < n; y++)
             for (uint64_t x = 0; x < n; x++) {
@@ -246,11 +246,19 @@ static void test_sphere_normals_and_offsets(void **state)
                  * sphere is (R - |c - C|) / h voxels from the centre along it. */
                 double d = oct_offset_decode((int8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
                 double exact = (R - len) / h;
+                /* A voxel the enclosures could not drop but the sphere
+                 * misses stores the nearest plane that still cuts it. */
+                if (fabs(exact) > 0.8660254037844386) {
+                    outside++;
+                    exact = copysign(0.8660254037844386, exact);
+                }
                 worst_offset = fmax(worst_offset, fabs(d - exact));
             }
     assert_true(seen > 0);
-    print_message("sphere: %llu voxels, worst normal %.4f deg, worst offset %.4f voxel\n",
-                  (unsigned long long)seen, worst_angle, worst_offset);
+    print_message("sphere: %llu voxels (%llu the sphere misses), worst normal %.4f deg, "
+                  "worst offset %.4f voxel\n",
+                  (unsigned long long)seen, (unsigned long long)outside, worst_angle, worst_offset);
+    assert_true(outside * 20 < seen); /* the shell stays thin: under 5% extra */
     assert_true(worst_angle < 0.5);   /* 12+12-bit code plus the Newton point */
     assert_true(worst_offset < 0.02); /* 1/256 quantisation plus curvature */
     assert_int_equal(b.st.normal_fallbacks, 0);
