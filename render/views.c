@@ -91,6 +91,7 @@ int views_parse(char *text, const views_view *base, views_view **out, size_t *co
         if (hash)
             *hash = '\0';
         views_view v = *base;
+        v.line = lineno;
         char msg[256];
         int line_bad = 0, any = 0;
         char *save = NULL;

@@ -22,6 +22,7 @@ typedef struct views_view {
     const char *out;     /* PNG path (required) */
     const char *depth;   /* PFM path or NULL */
     const char *normals; /* PNG path or NULL */
+    unsigned line;       /* views-file line (1-based), 0 for the command line */
 } views_view;
 
 /* The built-in defaults: 512x512, up 0,0,1, fov 30; eye and target unset
