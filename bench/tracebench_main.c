@@ -40,8 +40,16 @@ static oct_tree *sphere_shell(unsigned levels)
             double rest_near = r * r - ny * ny - nz * nz;
             if (rest_near < 0)
                 continue;
-            for (uint32_t x = 0; x < n; x++) {
+            /* only x where |x + 0.5 - c| can satisfy both tests */
+            double far_yz = fy * fy + fz * fz;
+            double dlo = r * r > far_yz ? sqrt(r * r - far_yz) - 1.0 : 0.0;
+            double dhi = sqrt(rest_near) + 1.0;
+            double xa = floor(c - dhi - 0.5), xb = ceil(c + dhi - 0.5);
+            for (double xd = xa < 0 ? 0 : xa; xd <= xb && xd < n; xd++) {
+                uint32_t x = (uint32_t)xd;
                 double dx0 = fabs(x + 0.5 - c);
+                if (dx0 < dlo)
+                    continue;
                 double nx = dx0 > 0.5 ? dx0 - 0.5 : 0, fx = dx0 + 0.5;
                 if (nx * nx > rest_near || fx * fx + fy * fy + fz * fz < r * r)
                     continue;
@@ -113,8 +121,9 @@ int main(int argc, char **argv)
             if (ms < best)
                 best = ms;
         }
-        printf("K=%2u (%u+%u): %8.1f ms  %7.2f Mrays/s  hits %.1f%%\n", k, k, levels - k, best,
-               (double)st.rays / best / 1e3, 100.0 * (double)st.hits / (double)st.rays);
+        printf("K=%2u (%u+%u): %8.1f ms  %7.2f Mrays/s  hits %.1f%%  %.1f steps/ray\n", k, k,
+               levels - k, best, (double)st.rays / best / 1e3,
+               100.0 * (double)st.hits / (double)st.rays, (double)st.steps / (double)st.rays);
         fflush(stdout);
     }
     if (getenv("TRACEBENCH_PNG"))

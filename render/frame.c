@@ -13,10 +13,11 @@
 typedef struct frame_shared {
     const frame_job *job;
     uint32_t tiles_x, tiles_y;
-    atomic_uint_fast64_t next, done, hits;
+    atomic_uint_fast64_t next, done, hits, steps;
 } frame_shared;
 
-static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t *hits)
+static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t *hits,
+                        uint64_t *steps)
 {
     const camera *cam = job->cam;
     const uint32_t w = cam->width;
@@ -43,6 +44,7 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
                     job->normals[3 * px + (size_t)a] =
                         h.hit ? (uint8_t)((n[a] * 0.5f + 0.5f) * 255.0f + 0.5f) : 0;
             *hits += (uint64_t)h.hit;
+            *steps += h.steps;
         }
     }
 }
@@ -50,17 +52,19 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
 static void work(frame_shared *sh, int caller)
 {
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
-    uint64_t hits = 0;
+    uint64_t hits = 0, steps = 0;
     for (;;) {
         uint64_t t = atomic_fetch_add(&sh->next, 1);
         if (t >= total)
             break;
-        render_tile(sh->job, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x), &hits);
+        render_tile(sh->job, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x), &hits,
+                    &steps);
         uint64_t d = atomic_fetch_add(&sh->done, 1) + 1;
         if (caller && sh->job->progress)
             sh->job->progress(sh->job->progress_ctx, d, total);
     }
     atomic_fetch_add(&sh->hits, hits);
+    atomic_fetch_add(&sh->steps, steps);
 }
 
 static void *worker(void *arg)
@@ -78,6 +82,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
     atomic_init(&sh.next, 0);
     atomic_init(&sh.done, 0);
     atomic_init(&sh.hits, 0);
+    atomic_init(&sh.steps, 0);
     unsigned extra = job->threads > 1 ? job->threads - 1 : 0;
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;
     int rc = 0;
@@ -95,5 +100,6 @@ int frame_render(const frame_job *job, frame_stats *stats)
     free(tid);
     stats->rays = (uint64_t)job->cam->width * job->cam->height;
     stats->hits = atomic_load(&sh.hits);
+    stats->steps = atomic_load(&sh.steps);
     return rc;
 }

@@ -30,7 +30,7 @@ typedef struct frame_job {
 } frame_job;
 
 typedef struct frame_stats {
-    uint64_t rays, hits;
+    uint64_t rays, hits, steps; /* steps: DDA steps, all rays */
 } frame_stats;
 
 /* Returns 0, or an errno value when a thread could not be started (the

@@ -174,6 +174,9 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     node[0] = 0;
     uint32_t v[3] = {r->v[0], r->v[1], r->v[2]};
     double tc = 0.0; /* local time the ray entered v */
+    const double otx = r->ot[0], oty = r->ot[1], otz = r->ot[2];
+    const double ivx = r->inv[0], ivy = r->inv[1], ivz = r->inv[2];
+    const double t_end = r->t_end;
     uint32_t steps = 0;
 
     for (;;) {
@@ -213,17 +216,13 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
 
         /* Leave the cell: the nearest of its three exit planes, all from T(). */
         const uint32_t cmask = ~(size - 1u);
-        uint32_t lo[3], b[3];
-        double tb[3];
-        for (int a = 0; a < 3; a++) {
-            lo[a] = v[a] & cmask;
-            b[a] = lo[a] + (size & up[a]);
-            tb[a] = trace_plane_time(r, a, (double)b[a]);
-        }
-        double te = tb[0] < tb[1] ? tb[0] : tb[1];
-        te = tb[2] < te ? tb[2] : te;
+        const uint32_t lx = v[0] & cmask, ly = v[1] & cmask, lz = v[2] & cmask;
+        const uint32_t bx = lx + (size & up[0]), by = ly + (size & up[1]), bz = lz + (size & up[2]);
+        const double tx = (bx - otx) * ivx, ty = (by - oty) * ivy, tz = (bz - otz) * ivz;
+        double te = tx < ty ? tx : ty;
+        te = tz < te ? tz : te;
         if (occupied) {
-            double tp = plane_time(tree, r, vidx, v, tc, te < r->t_end ? te : r->t_end);
+            double tp = plane_time(tree, r, vidx, v, tc, te < t_end ? te : t_end);
             if (tp >= 0.0) {
                 hit->hit = 1;
                 hit->voxel = vidx;
@@ -231,28 +230,34 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
                 break;
             }
         }
-        if (te >= r->t_end || ++steps > max_steps)
+        if (te >= t_end || ++steps > max_steps)
             break;
-        uint32_t nv[3];
-        for (int a = 0; a < 3; a++) {
-            if (tb[a] == te)
-                nv[a] = up[a] ? b[a] : b[a] - 1u;
-            else if (size > 1u && (r->active >> a & 1u))
-                nv[a] = settle(r, a,
-                               floor_clamp(r->o[a] + te * r->d[a], lo[a], lo[a] + size - 1u),
-                               lo[a], lo[a] + size - 1u, te);
-            else
-                nv[a] = v[a];
+        uint32_t nx, ny, nz;
+        if (size == 1u) {
+            /* step two: unit steps, only the axes whose plane comes first */
+            nx = tx == te ? (up[0] ? bx : bx - 1u) : v[0];
+            ny = ty == te ? (up[1] ? by : by - 1u) : v[1];
+            nz = tz == te ? (up[2] ? bz : bz - 1u) : v[2];
+        } else {
+            const uint32_t hi = size - 1u;
+            nx = tx == te ? (up[0] ? bx : bx - 1u)
+                 : (r->active & 1u) ? settle(r, 0, floor_clamp(r->o[0] + te * r->d[0], lx, lx + hi), lx, lx + hi, te)
+                                    : v[0];
+            ny = ty == te ? (up[1] ? by : by - 1u)
+                 : (r->active & 2u) ? settle(r, 1, floor_clamp(r->o[1] + te * r->d[1], ly, ly + hi), ly, ly + hi, te)
+                                    : v[1];
+            nz = tz == te ? (up[2] ? bz : bz - 1u)
+                 : (r->active & 4u) ? settle(r, 2, floor_clamp(r->o[2] + te * r->d[2], lz, lz + hi), lz, lz + hi, te)
+                                    : v[2];
         }
         /* Figure 3's XOR: the highest changed bit names the common ancestor. */
-        uint32_t diff = (v[0] ^ nv[0]) | (v[1] ^ nv[1]) | (v[2] ^ nv[2]);
-        unsigned h = 31u - (unsigned)__builtin_clz(diff | 1u);
-        unsigned keep = levels - 1u - h;
+        const uint32_t diff = (v[0] ^ nx) | (v[1] ^ ny) | (v[2] ^ nz);
+        const unsigned keep = levels - 1u - (31u - (unsigned)__builtin_clz(diff | 1u));
         if (keep < valid)
             valid = keep;
-        v[0] = nv[0];
-        v[1] = nv[1];
-        v[2] = nv[2];
+        v[0] = nx;
+        v[1] = ny;
+        v[2] = nz;
         tc = te;
     }
     hit->xyz[0] = v[0];
