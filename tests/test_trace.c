@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "format/oct_normal.h"
 #include "render/trace.h"
 #include "tests/tree_util.h"
 
@@ -63,6 +64,56 @@ static long oracle(const trace_ray *r, unsigned levels, const uint32_t (*vox)[3]
     return best;
 }
 
+/* --refine oracle: among voxels with a non-empty interval [lo, hi), the one
+ * with the smallest lo whose stored plane (n . (p - centre) = offset, voxel
+ * units) is met at some t in [lo, hi]. Same arithmetic as the tracer. */
+static long oracle_refine(const trace_ray *r, const oct_tree *tree, const uint32_t (*vox)[3],
+                          size_t n, double *t_out)
+{
+    const uint32_t lim = UINT32_C(1) << tree->levels;
+    long best = -1;
+    double best_lo = INFINITY, best_t = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double lo = 0.0, hi = INFINITY;
+        int ok = 1;
+        for (int a = 0; a < 3 && ok; a++) {
+            double k = (double)vox[i][a];
+            if (!(r->active >> a & 1)) {
+                double f = floor(r->o[a]);
+                ok = vox[i][a] == (f >= (double)lim ? lim - 1 : (uint32_t)f);
+                continue;
+            }
+            double en = trace_plane_time(r, a, r->sgn[a] > 0 ? k : k + 1);
+            double ex = trace_plane_time(r, a, r->sgn[a] > 0 ? k + 1 : k);
+            lo = en > lo ? en : lo;
+            hi = ex < hi ? ex : hi;
+        }
+        if (!ok || !(lo < hi) || !(lo < best_lo))
+            continue;
+        /* the record of voxel i: attrs hold i + 1 */
+        uint32_t rec = (uint32_t)i + 1;
+        float nf[3];
+        oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, nf);
+        double num = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT)), den = 0.0;
+        for (int a = 0; a < 3; a++) {
+            num -= (double)nf[a] * (r->o[a] - ((double)vox[i][a] + 0.5));
+            den += (double)nf[a] * r->d[a];
+        }
+        if (den == 0.0)
+            continue;
+        double tp = num / den;
+        if (hi > r->t_end)
+            hi = r->t_end;
+        if (tp >= lo && tp <= hi) {
+            best = (long)i;
+            best_lo = lo;
+            best_t = tp;
+        }
+    }
+    *t_out = best_t;
+    return best;
+}
+
 /* A grid-space coordinate of one of the kinds the plan asks for. */
 static double pick_coord(uint32_t lim)
 {
@@ -102,8 +153,23 @@ static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, 
     st->rays++;
     if (want >= 0)
         st->hits++;
+    double rt = INFINITY;
+    long want_refined = in ? oracle_refine(&r, tree, vox, n, &rt) : -1;
     for (unsigned k = k_min; k <= tree->levels; k++) {
-        for (int refine = 0; refine < 1; refine++) {
+        for (int refine = 0; refine <= 1; refine++) {
+            if (refine) {
+                trace_opts ro = {k, 1};
+                trace_hit rh;
+                trace_ray_cast(tree, &ro, eye, dir, &rh);
+                st->traces++;
+                assert_true(rh.steps <= trace_max_steps(tree->levels));
+                assert_int_equal(rh.hit, want_refined >= 0);
+                if (want_refined >= 0) {
+                    assert_memory_equal(rh.xyz, vox[want_refined], sizeof rh.xyz);
+                    assert_true(rh.t == r.t_base + rt);
+                }
+                continue;
+            }
             trace_opts opts = {k, refine};
             trace_hit h;
             trace_ray_cast(tree, &opts, eye, dir, &h);
@@ -330,6 +396,10 @@ static void test_tree_util_layout(void **state)
 
 int main(void)
 {
+    /* TEST_SEED=N replays another deterministic stream of rays and trees */
+    const char *seed = getenv("TEST_SEED");
+    if (seed && *seed)
+        rng_state ^= strtoull(seed, NULL, 10) * 0x9e3779b97f4a7c15ULL + 1;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tree_util_layout),
         cmocka_unit_test(test_empty_tree_and_degenerate_rays),
