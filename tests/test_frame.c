@@ -1,0 +1,128 @@
+/* Tests for render/frame: identical bytes whatever the thread count; depth is
+ * finite or +inf, never NaN, for degenerate cameras, under FE_INVALID traps. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <fenv.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "format/oct_normal.h"
+#include "render/frame.h"
+#include "tests/tree_util.h"
+
+static oct_tree *ball(unsigned levels)
+{
+    const uint32_t n = UINT32_C(1) << levels;
+    uint32_t(*xyz)[3] = malloc((size_t)n * n * n * sizeof *xyz);
+    uint32_t *attr = malloc((size_t)n * n * n * sizeof *attr);
+    assert_non_null(xyz);
+    assert_non_null(attr);
+    size_t cnt = 0;
+    double c = 0.5 * n, r = 0.35 * n;
+    for (uint32_t z = 0; z < n; z++)
+        for (uint32_t y = 0; y < n; y++)
+            for (uint32_t x = 0; x < n; x++) {
+                double p[3] = {x + 0.5 - c, y + 0.5 - c, z + 0.5 - c};
+                double d = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+                if (fabs(d - r) < 0.9) {
+                    xyz[cnt][0] = x;
+                    xyz[cnt][1] = y;
+                    xyz[cnt][2] = z;
+                    attr[cnt++] = oct_voxel_pack(p, 0.1);
+                }
+            }
+    const double origin[3] = {-1, -1, -1};
+    oct_tree *t = tree_util_build(levels, origin, 2.0, (const uint32_t(*)[3])xyz, cnt, attr, NULL,
+                                  1, NULL);
+    free(xyz);
+    free(attr);
+    assert_non_null(t);
+    return t;
+}
+
+static void render(const oct_tree *t, const camera *cam, unsigned threads, int refine,
+                   uint8_t *rgb, float *depth, uint8_t *nrm, frame_stats *st)
+{
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = t;
+    job.cam = cam;
+    job.opts.split = t->levels - 2;
+    job.opts.refine = refine;
+    job.shade.ambient = 0.2f;
+    shade_default_light(cam, job.shade.light);
+    job.rgb = rgb;
+    job.depth = depth;
+    job.normals = nrm;
+    job.threads = threads;
+    assert_int_equal(frame_render(&job, st), 0);
+}
+
+static void test_threads_identical(void **state)
+{
+    (void)state;
+    oct_tree *t = ball(6);
+    camera cam;
+    const double eye[3] = {2.2, 1.6, 1.9}, target[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+    assert_int_equal(camera_init(&cam, eye, target, up, 40, 97, 61), CAMERA_OK);
+    size_t px = 97 * 61;
+    for (int refine = 0; refine <= 1; refine++) {
+        uint8_t *a = malloc(px * 3), *b = malloc(px * 3), *na = malloc(px * 3), *nb = malloc(px * 3);
+        float *da = malloc(px * 4), *db = malloc(px * 4);
+        frame_stats sa, sb;
+        render(t, &cam, 1, refine, a, da, na, &sa);
+        render(t, &cam, 3, refine, b, db, nb, &sb);
+        assert_memory_equal(a, b, px * 3);
+        assert_memory_equal(na, nb, px * 3);
+        assert_memory_equal(da, db, px * 4);
+        assert_int_equal(sa.hits, sb.hits);
+        assert_true(sa.hits > px / 10);
+        free(a), free(b), free(na), free(nb), free(da), free(db);
+    }
+    tree_util_free(t);
+}
+
+static void test_degenerate_cameras_no_nan(void **state)
+{
+    (void)state;
+    oct_tree *t = ball(5);
+    static const double eyes[][3] = {
+        {-5, 0, 0},     /* axis-aligned, odd size: centre ray (1,0,0) exactly */
+        {-1, -1, -1},   /* on the root corner */
+        {-1, 0.25, 0},  /* on a root face */
+        {0.7, 0, 0},    /* inside the cube, inside the ball */
+        {1e30, 1e30, 1e30},
+    };
+    const double target[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+    feenableexcept(FE_INVALID);
+    for (size_t k = 0; k < sizeof eyes / sizeof eyes[0]; k++) {
+        camera cam;
+        double fov = k == 4 ? 1e-20 : 60;
+        assert_int_equal(camera_init(&cam, eyes[k], target, up, fov, 33, 17), CAMERA_OK);
+        uint8_t rgb[33 * 17 * 3];
+        float depth[33 * 17];
+        frame_stats st;
+        for (int refine = 0; refine <= 1; refine++) {
+            render(t, &cam, 2, refine, rgb, depth, NULL, &st);
+            for (size_t i = 0; i < 33 * 17; i++)
+                assert_true(!isnan(depth[i]) && depth[i] >= 0);
+        }
+        assert_true(st.steps <= st.rays * trace_max_steps(t->levels));
+    }
+    fedisableexcept(FE_INVALID);
+    tree_util_free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_degenerate_cameras_no_nan),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
