@@ -21,15 +21,6 @@
 
 /* The reader lands from another branch; until then the program builds and
  * reports that it cannot open files. */
-#if defined(__has_include)
-#if __has_include("format/oct_read.c")
-#define HAVE_OCT_READER 1
-#endif
-#endif
-#ifndef HAVE_OCT_READER
-#define HAVE_OCT_READER 0
-#endif
-
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
@@ -173,9 +164,7 @@ int main(int argc, char **argv)
     uint8_t *rgb = NULL, *nrm = NULL;
     float *depth = NULL;
     camera *cams = NULL;
-#if HAVE_OCT_READER
     oct_file *file = NULL;
-#endif
     const oct_tree *tree = NULL;
 
     for (int i = 1; i < argc; i++) {
@@ -280,7 +269,6 @@ int main(int argc, char **argv)
         }
     }
 
-#if HAVE_OCT_READER
     {
         uint64_t off = 0;
         oct_err err = oct_open(oct_path, 0, &file, &off);
@@ -288,7 +276,7 @@ int main(int argc, char **argv)
             if (err == OCT_EIO)
                 diag_path_error(oct_path, "%s", strerror(errno));
             else if (off)
-                diag_path_error(oct_path, "%s (at byte %llu)", oct_strerror(err),
+                diag_path_error(oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
                                 (unsigned long long)off);
             else
                 diag_path_error(oct_path, "%s", oct_strerror(err));
@@ -302,11 +290,6 @@ int main(int argc, char **argv)
             goto done;
         }
     }
-#else
-    diag_path_error(oct_path, "this build has no .oct reader");
-    status = EXIT_RUNTIME;
-    goto done;
-#endif
     if (!views_path && !base.out)
         goto done; /* --info only */
     if (split > (long)tree->levels) {
@@ -450,9 +433,6 @@ done:
     free(cams);
     free(list);
     free(views_text);
-#if HAVE_OCT_READER
     oct_close(file);
-#endif
-    (void)tree;
     return status;
 }
