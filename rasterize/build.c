@@ -82,8 +82,9 @@ typedef struct build_ctx {
     const tape **full;         /* full tape of each surface */
     uint32_t *tape_off;        /* offset of each surface's prune buffer */
     uint32_t tape_total;       /* sum of tape lengths */
+    uint32_t *konst_off;       /* offset of each surface's pruned constant pool */
+    uint32_t konst_total;      /* sum of (constants + instructions) over the surfaces */
     uint32_t max_len;
-    uint8_t *has_minmax;       /* pruning only pays where a min or max can be decided */
 } build_ctx;
 
 /* What one task produced: the subtree below one depth-S cell. */
@@ -103,6 +104,7 @@ typedef struct worker {
     tape_dual *dslots;
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
+    tape_const *prune_konst; /* [(levels + 2) * konst_total] */
     tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
     uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
     unsigned *nact;        /* [levels + 2] */
@@ -124,12 +126,14 @@ static int worker_init(worker *wk, const build_ctx *c)
     wk->dslots = malloc(len * sizeof *wk->dslots);
     wk->scratch = malloc(len * sizeof *wk->scratch);
     wk->prune = malloc(depths * c->tape_total * sizeof *wk->prune);
+    wk->prune_konst = malloc(depths * c->konst_total * sizeof *wk->prune_konst);
     wk->tapes = calloc(depths * c->nsurf, sizeof *wk->tapes);
     wk->act = calloc(depths * c->nsurf, 1);
     wk->nact = calloc(depths, sizeof *wk->nact);
     wk->grad = calloc(depths * c->nsurf * 3, sizeof *wk->grad);
     wk->grad_ok = calloc(depths * c->nsurf, 1);
     if (!wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->scratch || !wk->prune ||
+        !wk->prune_konst ||
         !wk->tapes || !wk->act || !wk->nact || !wk->grad || !wk->grad_ok)
         return -1;
     for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
@@ -143,7 +147,8 @@ static int worker_init(worker *wk, const build_ctx *c)
 static void worker_free(worker *wk)
 {
     free(wk->slots); free(wk->slots2); free(wk->islots); free(wk->dslots);
-    free(wk->scratch); free(wk->prune); free(wk->tapes); free(wk->act); free(wk->nact);
+    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act);
+    free(wk->nact);
     free(wk->grad); free(wk->grad_ok);
 }
 
@@ -278,9 +283,18 @@ static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint6
             continue;
         wk->act[(size_t)idx * ns + n++] = (uint8_t)s;
         tape *child = &wk->tapes[(size_t)idx * ns + s];
-        if (depth < c->levels && c->has_minmax[s]) {
+        if (depth < c->levels) {
+            /* Inherited by the whole subtree: decided min/max keep their
+             * winner, and terms that no longer vary over the cell (a far
+             * blob's exp(-50)) become constants. "No longer vary": narrower
+             * than a thousandth of f's spread over one voxel, estimated from
+             * its enclosure over this cell. */
+            interval v = wk->slots[t->root];
+            double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(c->levels - depth));
             tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
-            tape_prune(t, wk->slots, flags, out, wk->scratch, child);
+            tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
+            tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
+                             wk->scratch, child);
         } else {
             *child = *t;
         }
@@ -640,14 +654,6 @@ void build_cube(const scene *sc, double origin[3], double *edge)
     *edge = e;
 }
 
-static int tape_has_minmax(const tape *t)
-{
-    for (uint32_t i = 0; i < t->n; i++)
-        if (t->insn[i].op == TAPE_MIN || t->insn[i].op == TAPE_MAX)
-            return 1;
-    return 0;
-}
-
 oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats)
 {
     memset(stats, 0, sizeof *stats);
@@ -672,8 +678,8 @@ oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, buil
     unsigned started = 0;
     c.full = calloc(c.nsurf, sizeof *c.full);
     c.tape_off = calloc(c.nsurf, sizeof *c.tape_off);
-    c.has_minmax = calloc(c.nsurf, 1);
-    if (!c.full || !c.tape_off || !c.has_minmax)
+    c.konst_off = calloc(c.nsurf, sizeof *c.konst_off);
+    if (!c.full || !c.tape_off || !c.konst_off)
         goto done;
     for (unsigned s = 0; s < c.nsurf; s++) {
         c.full[s] = &sc->surfaces[s].tape;
@@ -681,7 +687,8 @@ oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, buil
         c.tape_total += c.full[s]->n;
         if (c.full[s]->n > c.max_len)
             c.max_len = c.full[s]->n;
-        c.has_minmax[s] = (uint8_t)tape_has_minmax(c.full[s]);
+        c.konst_off[s] = c.konst_total;
+        c.konst_total += c.full[s]->nconst + c.full[s]->n;
     }
 
     pl.c = &c;
@@ -743,6 +750,6 @@ done:
     free(pl.tasks);
     free(c.full);
     free(c.tape_off);
-    free(c.has_minmax);
+    free(c.konst_off);
     return err;
 }
