@@ -654,6 +654,19 @@ void build_cube(const scene *sc, double origin[3], double *edge)
     *edge = e;
 }
 
+void build_writer_params(const scene *sc, unsigned levels, float palette[3 * OCT_MAX_SURFACES],
+                         oct_writer_params *wp)
+{
+    memset(wp, 0, sizeof *wp);
+    wp->levels = levels;
+    build_cube(sc, wp->origin, &wp->edge);
+    wp->surface_count = (uint32_t)sc->nsurfaces;
+    for (size_t s = 0; s < sc->nsurfaces && s < OCT_MAX_SURFACES; s++)
+        for (int k = 0; k < 3; k++)
+            palette[3 * s + k] = (float)sc->surfaces[s].color[k];
+    wp->palette = palette;
+}
+
 oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats)
 {
     memset(stats, 0, sizeof *stats);
