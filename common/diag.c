@@ -45,4 +45,16 @@ void diag_at(const char *file, unsigned line, unsigned col, const char *fmt, ...
     va_end(ap);
 }
 
+int diag_usage_error(const char *usage, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "%s: ", progname);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    fputs(usage, stderr);
+    va_end(ap);
+    return EXIT_USAGE;
+}
+
 int diag_stderr_is_tty(void) { return isatty(STDERR_FILENO); }

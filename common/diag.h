@@ -23,6 +23,10 @@ void diag_path_error(const char *path, const char *fmt, ...) __attribute__((form
 void diag_at(const char *file, unsigned line, unsigned col, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
+/* "prog: <fmt>\n" and then `usage` on stderr; returns EXIT_USAGE (2), for
+ * `return diag_usage_error(...)` from main's option parsing. */
+int diag_usage_error(const char *usage, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
 /* True when stderr is a terminal (progress bars are drawn only then). */
 int diag_stderr_is_tty(void);
 

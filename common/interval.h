@@ -124,11 +124,12 @@ static inline interval interval_add(interval a, interval b, unsigned *flags)
         hi = INFINITY;
         *flags |= INTERVAL_MAYBE_NAN;
     }
-    /* A sum below the smallest normal is exact (Hauser 1996, "Handling
-     * floating-point exceptions in numeric programs", theorem 3.4.1), so a
-     * zero sum stays zero instead of widening to +-DBL_MIN: see interval_mul. */
-    return interval__mk(lo > -0x1p-1022 && lo < 0x1p-1022 ? lo : interval_next_down(lo),
-                        hi > -0x1p-1022 && hi < 0x1p-1022 ? hi : interval_next_up(hi));
+    /* x + y == 0 exactly when x == -y: such a zero is exact and stays zero
+     * instead of widening to +-DBL_MIN (see interval_mul). The test is on the
+     * operands, not the sum, so it stays sound where subnormal results are
+     * flushed to zero (the rasterizer's workers run so). */
+    return interval__mk(lo == 0.0 && a.lo == -b.lo ? lo : interval_next_down(lo),
+                        hi == 0.0 && a.hi == -b.hi ? hi : interval_next_up(hi));
 }
 
 static inline interval interval_sub(interval a, interval b, unsigned *flags)

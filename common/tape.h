@@ -137,6 +137,19 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
 uint32_t tape_prune(const tape *t, const interval *slots, unsigned flags, tape_insn *out_insn,
                     uint32_t *scratch, tape *out);
 
+/* tape_prune, and more: every instruction whose enclosure over the box is
+ * narrower than `tiny` (finite) becomes a constant holding that enclosure,
+ * and whatever only it used is dropped — a far blob's exp(-50) is then one
+ * constant. Sound on the box and its sub-boxes for every evaluator: the
+ * pruned tape stands for the family of functions with that term anywhere in
+ * its interval, and f is one of them at every point, so interval, gradient
+ * and mean-value enclosures still hold f. The point value of such a constant
+ * is its midpoint (off by at most tiny / 2). `out_konst` is a caller buffer
+ * of t->nconst + t->n entries and becomes the pruned tape's constant pool.
+ * With flags set nothing is replaced, as in tape_prune. */
+uint32_t tape_prune_const(const tape *t, const interval *slots, unsigned flags, double tiny,
+                          tape_insn *out_insn, tape_const *out_konst, uint32_t *scratch, tape *out);
+
 /* Name of an op, for dumps. */
 const char *tape_op_name(tape_op op);
 

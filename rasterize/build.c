@@ -19,6 +19,9 @@
 
 #include <math.h>
 #include <pthread.h>
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,9 +31,13 @@
 #include "format/oct_normal.h"
 
 #define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
+#define MEAN_VALUE_LEVELS 3   /* the finest levels whose cells the mean-value form tests */
+_Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradient enclosure");
 #define NEWTON_STEPS 4        /* guarded Newton steps from the voxel centre onto f = 0 */
-#define NEWTON_TOL 0.02       /* stop once a step is below this fraction of a voxel: the
-                                 linearisation there is then far inside the offset step */
+#define NEWTON_TOL 0.25       /* stop once a step is below this fraction of a voxel: the
+                                 linearisation error there, curvature x step^2 / 2, is far
+                                 below the 1/128-voxel offset step at any level where the
+                                 surface is resolved */
 #define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
 
 /* --- growable buffers -------------------------------------------------- */
@@ -75,8 +82,9 @@ typedef struct build_ctx {
     const tape **full;         /* full tape of each surface */
     uint32_t *tape_off;        /* offset of each surface's prune buffer */
     uint32_t tape_total;       /* sum of tape lengths */
+    uint32_t *konst_off;       /* offset of each surface's pruned constant pool */
+    uint32_t konst_total;      /* sum of (constants + instructions) over the surfaces */
     uint32_t max_len;
-    uint8_t *has_minmax;       /* pruning only pays where a min or max can be decided */
 } build_ctx;
 
 /* What one task produced: the subtree below one depth-S cell. */
@@ -96,9 +104,12 @@ typedef struct worker {
     tape_dual *dslots;
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
+    tape_const *prune_konst; /* [(levels + 2) * konst_total] */
     tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
     uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
     unsigned *nact;        /* [levels + 2] */
+    interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
+    uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
     task_out *out;
     build_stats st;
     int failed;
@@ -115,11 +126,15 @@ static int worker_init(worker *wk, const build_ctx *c)
     wk->dslots = malloc(len * sizeof *wk->dslots);
     wk->scratch = malloc(len * sizeof *wk->scratch);
     wk->prune = malloc(depths * c->tape_total * sizeof *wk->prune);
+    wk->prune_konst = malloc(depths * c->konst_total * sizeof *wk->prune_konst);
     wk->tapes = calloc(depths * c->nsurf, sizeof *wk->tapes);
     wk->act = calloc(depths * c->nsurf, 1);
     wk->nact = calloc(depths, sizeof *wk->nact);
+    wk->grad = calloc(depths * c->nsurf * 3, sizeof *wk->grad);
+    wk->grad_ok = calloc(depths * c->nsurf, 1);
     if (!wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->scratch || !wk->prune ||
-        !wk->tapes || !wk->act || !wk->nact)
+        !wk->prune_konst ||
+        !wk->tapes || !wk->act || !wk->nact || !wk->grad || !wk->grad_ok)
         return -1;
     for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
         wk->tapes[s] = *c->full[s];
@@ -132,7 +147,9 @@ static int worker_init(worker *wk, const build_ctx *c)
 static void worker_free(worker *wk)
 {
     free(wk->slots); free(wk->slots2); free(wk->islots); free(wk->dslots);
-    free(wk->scratch); free(wk->prune); free(wk->tapes); free(wk->act); free(wk->nact);
+    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act);
+    free(wk->nact);
+    free(wk->grad); free(wk->grad_ok);
 }
 
 /* --- cell tests ----------------------------------------------------------- */
@@ -168,15 +185,20 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
     return !fl && !interval_is_nan(*fc);
 }
 
-/* 1 when fc + G . (box - c), the mean-value form (fc encloses f(c), G the
- * gradient over a convex set holding c and box), proves f != 0 on box. */
-static int mean_value_excludes_zero(interval fc, const interval G[3], const interval box[3],
-                                    const double c[3])
+/* The mean-value form centred on the voxel itself, f([c]) + G . (box - c),
+ * with G the enclosure made for its parent: tighter than the node-centred
+ * form by the width of G times the offset of the centres, for one
+ * point-interval evaluation. Run on the voxels that form let through. */
+static int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
+                                      const interval box[3], const double centre[3])
 {
+    interval fc;
+    if (!eval_at_centre(wk, t, centre, &fc))
+        return 0;
     unsigned fl = 0;
     interval sum = fc;
     for (int k = 0; k < 3; k++) {
-        interval r = {interval_next_down(box[k].lo - c[k]), interval_next_up(box[k].hi - c[k])};
+        interval r = {interval_next_down(box[k].lo - centre[k]), interval_next_up(box[k].hi - centre[k])};
         sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
     }
     return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
@@ -244,13 +266,12 @@ static int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
 
 /* Tests the cell (depth, cell) for every surface that may cross its parent
  * (lists at index pidx). Fills the cell's lists at index depth + 1 and, when
- * it will be subdivided, its pruned tapes. Returns how many surfaces may
- * cross it. */
-static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3])
+ * it will be subdivided, its pruned tapes; box and centre receive the cell's
+ * box. Returns how many surfaces may cross it. */
+static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
+                          interval box[3], double centre[3])
 {
     const build_ctx *c = wk->c;
-    interval box[3];
-    double centre[3];
     if (!cell_box(c, depth, cell, box, centre))
         return 0;
     unsigned idx = depth + 1, n = 0, ns = c->nsurf;
@@ -262,9 +283,18 @@ static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint6
             continue;
         wk->act[(size_t)idx * ns + n++] = (uint8_t)s;
         tape *child = &wk->tapes[(size_t)idx * ns + s];
-        if (depth < c->levels && c->has_minmax[s]) {
+        if (depth < c->levels) {
+            /* Inherited by the whole subtree: decided min/max keep their
+             * winner, and terms that no longer vary over the cell (a far
+             * blob's exp(-50)) become constants. "No longer vary": narrower
+             * than a thousandth of f's spread over one voxel, estimated from
+             * its enclosure over this cell. */
+            interval v = wk->slots[t->root];
+            double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(c->levels - depth));
             tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
-            tape_prune(t, wk->slots, flags, out, wk->scratch, child);
+            tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
+            tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
+                             wk->scratch, child);
         } else {
             *child = *t;
         }
@@ -331,13 +361,10 @@ static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], c
 
 /* Appends the voxel's record; with several surfaces it belongs to the one
  * nearest its centre by the first-order distance |f| / |grad f|. */
-static int emit_voxel(worker *wk, const uint64_t cell[3])
+static int emit_voxel(worker *wk, const interval box[3], const double centre[3])
 {
     const build_ctx *c = wk->c;
     unsigned idx = c->levels + 1, ns = c->nsurf;
-    interval box[3];
-    double centre[3];
-    cell_box(c, c->levels, cell, box, centre);
     unsigned best = wk->act[(size_t)idx * ns];
     if (wk->nact[idx] > 1) {
         double best_dist = INFINITY;
@@ -367,56 +394,101 @@ static int emit_voxel(worker *wk, const uint64_t cell[3])
     return 1;
 }
 
-/* Tests the voxels of a leaf-parent node (depth levels - 1) and emits those
- * that survive. With c the node's centre and G an enclosure of the gradient
- * over the node, a voxel is dropped when f([c]) + G . (voxel - c) excludes 0:
- * the mean-value form, sound because every voxel lies inside the node. That
- * is one interval-gradient and one point-interval evaluation per node, and a
- * three-term dot product per voxel, where the plain test needs a tape
- * evaluation per voxel; and at this scale the form is the tighter of the
- * two (its excess width shrinks with the square of the cell size). Where the
- * gradient may be undefined (flags), the plain interval test is used. */
-static uint8_t visit_leaf_parent(worker *wk, unsigned depth, const uint64_t cell[3])
+static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3]);
+
+/* The mean-value enclosures of a node's eight children. With c the node's
+ * centre, fc an enclosure of f(c) and G one of the gradient over the node,
+ * every point p of child i satisfies f(p) in fc + sum_k G_k (p_k - c_k), and
+ * p_k - c_k lies in the lower or upper half-offset of axis k according to
+ * bit k of i. The six products are formed once, so a child costs three
+ * interval additions and no tape evaluation. The form's excess width shrinks
+ * with the square of the cell size, so on the finest levels it is tighter
+ * than the plain interval as well as cheaper. Returns 0 when G or f(c) may be
+ * undefined (then the caller tests the children one by one). */
+static int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
+                            unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
+                            interval out[8])
 {
     const build_ctx *c = wk->c;
-    const unsigned ns = c->nsurf, pidx = depth + 1, vidx = depth + 2;
-    int lipschitz = c->par->method == BUILD_LIPSCHITZ;
-    interval pbox[3], G[OCT_MAX_SURFACES][3], fc[OCT_MAX_SURFACES];
-    double pc[3];
-    uint8_t plain[OCT_MAX_SURFACES], mask = 0;
-    cell_box(c, depth, cell, pbox, pc);
-    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
-        unsigned s = wk->act[(size_t)pidx * ns + k], fl = 0;
-        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-        plain[k] = 1;
-        if (lipschitz)
-            continue;
-        tape_eval_interval_grad(t, pbox, G[k], wk->islots, &fl);
+    interval fc, half[3][2];
+    unsigned fl = 0;
+    if (!reuse_G) {
+        tape_eval_interval_grad(t, pbox, G, wk->islots, &fl);
         wk->st.gradient_evals++;
-        plain[k] = fl != 0 || !eval_at_centre(wk, t, pc, &fc[k]);
+    }
+    if (fl || !eval_at_centre(wk, t, pc, &fc))
+        return 0;
+    for (int k = 0; k < 3; k++) {
+        /* The children's shared face, rounded as cell_box rounds it. */
+        double m = c->origin[k] + (double)(2 * cell[k] + 1) * c->cell_edge[depth + 1];
+        interval lo = {interval_next_down(pbox[k].lo - pc[k]), interval_next_up(interval_next_up(m) - pc[k])};
+        interval hi = {interval_next_down(interval_next_down(m) - pc[k]), interval_next_up(pbox[k].hi - pc[k])};
+        half[k][0] = interval_mul(G[k], lo, &fl);
+        half[k][1] = interval_mul(G[k], hi, &fl);
+    }
+    for (unsigned i = 0; i < 8; i++) {
+        interval sum = interval_add(fc, half[0][i & 1], &fl);
+        sum = interval_add(sum, half[1][(i >> 1) & 1], &fl);
+        out[i] = interval_add(sum, half[2][i >> 2], &fl);
+    }
+    return !fl;
+}
+
+/* The finest levels: children are tested with child_enclosures, inheriting
+ * the node's tapes (pruning no longer pays this deep); voxels are emitted,
+ * deeper nodes recursed into. Where the mean-value form is not available for
+ * a surface (f or its gradient may be undefined), the plain test is used. */
+static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[3])
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1, cidx = depth + 2;
+    interval pbox[3], T[OCT_MAX_SURFACES][8];
+    double pc[3];
+    uint8_t ok[OCT_MAX_SURFACES], mask = 0;
+    cell_box(c, depth, cell, pbox, pc);
+    /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
+     * holds its own, one evaluation fewer for a slightly wider form. */
+    int reuse = depth + 1 == c->levels; /* its parent ran here too: MEAN_VALUE_LEVELS >= 2 */
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k];
+        interval *G = &wk->grad[((size_t)pidx * ns + s) * 3];
+        if (reuse && wk->grad_ok[(size_t)depth * ns + s])
+            memcpy(G, &wk->grad[((size_t)depth * ns + s) * 3], 3 * sizeof *G);
+        ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, pc, depth,
+                                          cell, G, reuse && wk->grad_ok[(size_t)depth * ns + s],
+                                          T[k]);
+        wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
         interval box[3];
         double centre[3];
-        if (!cell_box(c, depth + 1, cc, box, centre))
-            continue;
+        int have_box = 0; /* most children fall to T alone: make boxes lazily */
         unsigned n = 0;
         for (unsigned k = 0; k < wk->nact[pidx]; k++) {
             unsigned s = wk->act[(size_t)pidx * ns + k];
             const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-            if (plain[k]) {
-                if (!cell_may_cross(wk, t, s, depth + 1, box, centre))
-                    continue;
-            } else if (mean_value_excludes_zero(fc[k], G[k], box, pc)) {
+            if (ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) {
                 wk->st.taylor_drops++;
                 continue;
             }
-            wk->act[(size_t)vidx * ns + n++] = (uint8_t)s;
-            wk->tapes[(size_t)vidx * ns + s] = *t;
+            if (!have_box) {
+                if (!cell_box(c, depth + 1, cc, box, centre))
+                    break; /* outside the bounds */
+                have_box = 1;
+            }
+            if (!ok[k] ? !cell_may_cross(wk, t, s, depth + 1, box, centre)
+                       : depth + 1 == c->levels &&
+                             centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3],
+                                                        box, centre)) {
+                wk->st.taylor_drops += ok[k];
+                continue;
+            }
+            wk->act[(size_t)cidx * ns + n++] = (uint8_t)s;
+            wk->tapes[(size_t)cidx * ns + s] = *t;
         }
-        wk->nact[vidx] = n;
-        if (n && emit_voxel(wk, cc))
+        wk->nact[cidx] = n;
+        if (n && (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc)))
             mask |= (uint8_t)(1u << i);
     }
     return mask;
@@ -426,15 +498,19 @@ static uint8_t visit_leaf_parent(worker *wk, unsigned depth, const uint64_t cell
  * mask (0 when nothing below it survived). */
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
 {
-    const unsigned levels = wk->c->levels;
+    const build_ctx *c = wk->c;
     uint8_t mask = 0;
-    if (depth + 1 == levels) {
-        mask = visit_leaf_parent(wk, depth, cell);
+    if (depth + MEAN_VALUE_LEVELS >= c->levels && c->par->method == BUILD_INTERVAL) {
+        mask = visit_mean_value(wk, depth, cell);
     } else {
         for (unsigned i = 0; i < 8 && !wk->failed; i++) {
             uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1),
                               2 * cell[2] + (i >> 2)};
-            if (test_cell(wk, depth + 1, depth + 1, cc) && visit_node(wk, depth + 1, cc))
+            interval box[3];
+            double centre[3];
+            if (!test_cell(wk, depth + 1, depth + 1, cc, box, centre))
+                continue;
+            if (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc))
                 mask |= (uint8_t)(1u << i);
         }
     }
@@ -464,7 +540,9 @@ static void run_task(worker *wk, uint64_t task, task_out *out)
     uint64_t cell[3];
     morton_decode(task, c->task_depth, cell);
     wk->out = out;
-    if (test_cell(wk, 0, c->task_depth, cell))
+    interval box[3];
+    double centre[3];
+    if (test_cell(wk, 0, c->task_depth, cell, box, centre))
         out->nonempty = visit_node(wk, c->task_depth, cell) != 0;
 }
 
@@ -495,9 +573,22 @@ static void stats_add(build_stats *a, const build_stats *b)
     a->normal_fallbacks += b->normal_fallbacks;
 }
 
+/* Subnormal operands and results cost a microcode assist each on x86, and
+ * blobs such as exp(-196 (x - a)^4) underflow into them all over space. The
+ * workers flush them to zero (FTZ and DAZ). That stays sound: every interval
+ * bound is stepped outward after each operation, and a step from 0 reaches
+ * +-DBL_MIN, beyond any flushed value (common/interval.h). */
+static void flush_subnormals(void)
+{
+#if defined(__SSE2__)
+    _mm_setcsr(_mm_getcsr() | 0x8040u); /* FTZ (bit 15) | DAZ (bit 6) */
+#endif
+}
+
 static void *worker_main(void *arg)
 {
     pool *pl = arg;
+    flush_subnormals();
     worker wk;
     int failed = worker_init(&wk, pl->c) != 0;
     for (;;) {
@@ -563,12 +654,17 @@ void build_cube(const scene *sc, double origin[3], double *edge)
     *edge = e;
 }
 
-static int tape_has_minmax(const tape *t)
+void build_writer_params(const scene *sc, unsigned levels, float palette[3 * OCT_MAX_SURFACES],
+                         oct_writer_params *wp)
 {
-    for (uint32_t i = 0; i < t->n; i++)
-        if (t->insn[i].op == TAPE_MIN || t->insn[i].op == TAPE_MAX)
-            return 1;
-    return 0;
+    memset(wp, 0, sizeof *wp);
+    wp->levels = levels;
+    build_cube(sc, wp->origin, &wp->edge);
+    wp->surface_count = (uint32_t)sc->nsurfaces;
+    for (size_t s = 0; s < sc->nsurfaces && s < OCT_MAX_SURFACES; s++)
+        for (int k = 0; k < 3; k++)
+            palette[3 * s + k] = (float)sc->surfaces[s].color[k];
+    wp->palette = palette;
 }
 
 oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats)
@@ -595,8 +691,8 @@ oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, buil
     unsigned started = 0;
     c.full = calloc(c.nsurf, sizeof *c.full);
     c.tape_off = calloc(c.nsurf, sizeof *c.tape_off);
-    c.has_minmax = calloc(c.nsurf, 1);
-    if (!c.full || !c.tape_off || !c.has_minmax)
+    c.konst_off = calloc(c.nsurf, sizeof *c.konst_off);
+    if (!c.full || !c.tape_off || !c.konst_off)
         goto done;
     for (unsigned s = 0; s < c.nsurf; s++) {
         c.full[s] = &sc->surfaces[s].tape;
@@ -604,7 +700,8 @@ oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, buil
         c.tape_total += c.full[s]->n;
         if (c.full[s]->n > c.max_len)
             c.max_len = c.full[s]->n;
-        c.has_minmax[s] = (uint8_t)tape_has_minmax(c.full[s]);
+        c.konst_off[s] = c.konst_total;
+        c.konst_total += c.full[s]->nconst + c.full[s]->n;
     }
 
     pl.c = &c;
@@ -666,6 +763,6 @@ done:
     free(pl.tasks);
     free(c.full);
     free(c.tape_off);
-    free(c.has_minmax);
+    free(c.konst_off);
     return err;
 }

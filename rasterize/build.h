@@ -41,6 +41,11 @@ typedef struct build_stats {
 /* The cube the grid covers: min corner of `bounds`, edge = its longest side. */
 void build_cube(const scene *sc, double origin[3], double *edge);
 
+/* Writer parameters for the scene's grid at `levels`: its cube, its surface
+ * count and their colours, copied into `palette`, which wp points to. */
+void build_writer_params(const scene *sc, unsigned levels, float palette[3 * OCT_MAX_SURFACES],
+                         oct_writer_params *wp);
+
 /* Runs the whole subdivision and appends every node and voxel to `w`
  * (created by the caller with the same levels and cube). Returns OCT_OK,
  * OCT_ENOMEM, or the writer's error. *stats is filled in either way. */

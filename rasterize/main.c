@@ -40,18 +40,6 @@ static const char help_text[] =
     "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 
-static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int usage_error(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "%s: ", diag_progname());
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n%s", usage_text);
-    va_end(ap);
-    return EXIT_USAGE;
-}
-
 typedef struct progress {
     int enabled;
     int last;
@@ -136,40 +124,40 @@ int main(int argc, char **argv)
             quiet = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!has_value)
-                return usage_error("option '%s' needs a file name", a);
+                return diag_usage_error(usage_text, "option '%s' needs a file name", a);
             out_path = argv[++i];
         } else if (!strcmp(a, "--levels")) {
             if (!has_value)
-                return usage_error("option '%s' needs a value", a);
+                return diag_usage_error(usage_text, "option '%s' needs a value", a);
             if (parse_long(argv[++i], 1, OCT_MAX_LEVELS, &levels) != PARSE_OK)
-                return usage_error("--levels: '%s' is not an integer from 1 to 20", argv[i]);
+                return diag_usage_error(usage_text, "--levels: '%s' is not an integer from 1 to 20", argv[i]);
         } else if (!strcmp(a, "--threads")) {
             if (!has_value)
-                return usage_error("option '%s' needs a value", a);
+                return diag_usage_error(usage_text, "option '%s' needs a value", a);
             if (parse_long(argv[++i], 1, MAX_THREADS, &threads) != PARSE_OK)
-                return usage_error("--threads: '%s' is not an integer from 1 to 64", argv[i]);
+                return diag_usage_error(usage_text, "--threads: '%s' is not an integer from 1 to 64", argv[i]);
         } else if (!strcmp(a, "--method")) {
             if (!has_value)
-                return usage_error("option '%s' needs a value", a);
+                return diag_usage_error(usage_text, "option '%s' needs a value", a);
             const char *m = argv[++i];
             if (!strcmp(m, "interval"))
                 method = BUILD_INTERVAL;
             else if (!strcmp(m, "lipschitz"))
                 method = BUILD_LIPSCHITZ;
             else
-                return usage_error("--method: '%s' is not 'interval' or 'lipschitz'", m);
+                return diag_usage_error(usage_text, "--method: '%s' is not 'interval' or 'lipschitz'", m);
         } else if (a[0] == '-' && a[1] != '\0') {
-            return usage_error("unrecognized option '%s'", a);
+            return diag_usage_error(usage_text, "unrecognized option '%s'", a);
         } else if (!scene_path) {
             scene_path = a;
         } else {
-            return usage_error("unexpected argument '%s'", a);
+            return diag_usage_error(usage_text, "unexpected argument '%s'", a);
         }
     }
     if (!scene_path)
-        return usage_error("%s", "missing SCENE");
+        return diag_usage_error(usage_text, "%s", "missing SCENE");
     if (!out_path)
-        return usage_error("%s", "missing -o OUT.oct");
+        return diag_usage_error(usage_text, "%s", "missing -o OUT.oct");
 
     int status = EXIT_RUNTIME;
     scene *sc = NULL;
@@ -188,15 +176,8 @@ int main(int argc, char **argv)
     }
 
     float palette[3 * OCT_MAX_SURFACES];
-    for (size_t s = 0; s < sc->nsurfaces; s++)
-        for (int k = 0; k < 3; k++)
-            palette[3 * s + k] = (float)sc->surfaces[s].color[k];
     oct_writer_params wp;
-    memset(&wp, 0, sizeof wp);
-    wp.levels = (uint32_t)levels;
-    build_cube(sc, wp.origin, &wp.edge);
-    wp.surface_count = (uint32_t)sc->nsurfaces;
-    wp.palette = palette;
+    build_writer_params(sc, (unsigned)levels, palette, &wp);
     oct_err err = oct_writer_create(&wp, &w);
     if (err != OCT_OK) {
         diag_path_error(scene_path, "%s", oct_strerror(err));

@@ -22,15 +22,6 @@
 
 /* The reader lands from another branch; until then the program builds and
  * reports that it cannot open files. */
-#if defined(__has_include)
-#if __has_include("format/oct_read.c")
-#define HAVE_OCT_READER 1
-#endif
-#endif
-#ifndef HAVE_OCT_READER
-#define HAVE_OCT_READER 0
-#endif
-
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
@@ -61,19 +52,6 @@ static const char help_text[] =
     "  --info              print a summary of FILE.oct\n"
     "  -q                  no per-view timing lines\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
-
-static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int usage_error(const char *fmt, ...)
-{
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    diag_error("%s", msg);
-    fputs(usage_text, stderr);
-    return EXIT_USAGE;
-}
 
 static double now_ms(void)
 {
@@ -185,9 +163,7 @@ int main(int argc, char **argv)
     uint8_t *rgb = NULL, *nrm = NULL;
     float *depth = NULL;
     camera *cams = NULL;
-#if HAVE_OCT_READER
     oct_file *file = NULL;
-#endif
     const oct_tree *tree = NULL;
 
     for (int i = 1; i < argc; i++) {
@@ -200,7 +176,7 @@ int main(int argc, char **argv)
         }
         if (a[0] != '-' || a[1] == '\0') {
             if (oct_path)
-                return usage_error("unexpected argument '%s'", a);
+                return diag_usage_error(usage_text, "unexpected argument '%s'", a);
             oct_path = a;
             continue;
         }
@@ -221,14 +197,14 @@ int main(int argc, char **argv)
                     strcmp(a, "--light") == 0 || strcmp(a, "--background") == 0 ||
                     strcmp(a, "--threads") == 0;
         if (!known)
-            return usage_error("unrecognized option '%s'", a);
+            return diag_usage_error(usage_text, "unrecognized option '%s'", a);
         if (!val)
-            return usage_error("option '%s' needs a value", a);
+            return diag_usage_error(usage_text, "option '%s' needs a value", a);
         i++;
         parse_err e = PARSE_OK;
         if (views_is_option(a)) {
             if (views_apply(&base, a, val, msg, sizeof msg) != 0)
-                return usage_error("%s", msg);
+                return diag_usage_error(usage_text, "%s", msg);
         } else if (strcmp(a, "--views") == 0) {
             views_path = val;
         } else if (strcmp(a, "--orbit") == 0) {
@@ -241,7 +217,7 @@ int main(int argc, char **argv)
             e = parse_vec3(val, light);
             has_light = 1;
             if (e == PARSE_OK && light[0] == 0 && light[1] == 0 && light[2] == 0)
-                return usage_error("--light: %s: must not be the zero vector", val);
+                return diag_usage_error(usage_text, "--light: %s: must not be the zero vector", val);
         } else if (strcmp(a, "--background") == 0) {
             e = parse_vec3(val, bg);
             for (int k = 0; k < 3 && e == PARSE_OK; k++)
@@ -250,22 +226,22 @@ int main(int argc, char **argv)
         }
         if (e != PARSE_OK) {
             snprintf(msg, sizeof msg, "%s: '%s': %s", a, val, parse_strerror(e));
-            return usage_error("%s", msg);
+            return diag_usage_error(usage_text, "%s", msg);
         }
     }
     if (!oct_path)
-        return usage_error("%s", "no input file");
+        return diag_usage_error(usage_text, "%s", "no input file");
     if (views_path && orbit)
-        return usage_error("%s", "--views and --orbit cannot be combined");
+        return diag_usage_error(usage_text, "%s", "--views and --orbit cannot be combined");
     if (views_path && base.out)
-        return usage_error("%s", "-o goes into the views file with --views");
+        return diag_usage_error(usage_text, "%s", "-o goes into the views file with --views");
     if (!views_path && !base.out && !info)
-        return usage_error("%s", "no output: give -o OUT.png or --views FILE");
+        return diag_usage_error(usage_text, "%s", "no output: give -o OUT.png or --views FILE");
     if (orbit && views_check_pattern(base.out) != 0)
-        return usage_error("--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
+        return diag_usage_error(usage_text, "--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
                            base.out);
     if (orbit && (base.depth || base.normals))
-        return usage_error("%s", "--orbit writes colour images only (no --depth or --normals)");
+        return diag_usage_error(usage_text, "%s", "--orbit writes colour images only (no --depth or --normals)");
 
     if (views_path) {
         views_text = read_text(views_path);
@@ -292,7 +268,6 @@ int main(int argc, char **argv)
         }
     }
 
-#if HAVE_OCT_READER
     {
         uint64_t off = 0;
         oct_err err = oct_open(oct_path, 0, &file, &off);
@@ -300,7 +275,7 @@ int main(int argc, char **argv)
             if (err == OCT_EIO)
                 diag_path_error(oct_path, "%s", strerror(errno));
             else if (off)
-                diag_path_error(oct_path, "%s (at byte %llu)", oct_strerror(err),
+                diag_path_error(oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
                                 (unsigned long long)off);
             else
                 diag_path_error(oct_path, "%s", oct_strerror(err));
@@ -314,17 +289,12 @@ int main(int argc, char **argv)
             goto done;
         }
     }
-#else
-    diag_path_error(oct_path, "this build has no .oct reader");
-    status = EXIT_RUNTIME;
-    goto done;
-#endif
     if (!views_path && !base.out)
         goto done; /* --info only */
     if (split > (long)tree->levels) {
         snprintf(msg, sizeof msg, "--split %ld: the tree has only %u levels", split,
                  (unsigned)tree->levels);
-        status = usage_error("%s", msg);
+        status = diag_usage_error(usage_text, "%s", msg);
         goto done;
     }
 
@@ -333,7 +303,7 @@ int main(int argc, char **argv)
         if (orbit) {
             list = views_orbit(&base, (unsigned)orbit, base.out);
             if (!list) {
-                status = usage_error("%s", "--orbit: the eye lies on the up axis through the target");
+                status = diag_usage_error(usage_text, "%s", "--orbit: the eye lies on the up axis through the target");
                 goto done;
             }
             nviews = (size_t)orbit;
@@ -462,9 +432,6 @@ done:
     free(cams);
     free(list);
     free(views_text);
-#if HAVE_OCT_READER
     oct_close(file);
-#endif
-    (void)tree;
     return status;
 }

@@ -38,15 +38,8 @@ static void build_in_memory(const scene *sc, unsigned levels, build_method metho
 {
     memset(b, 0, sizeof *b);
     float palette[3 * OCT_MAX_SURFACES];
-    for (size_t s = 0; s < sc->nsurfaces; s++)
-        for (int k = 0; k < 3; k++)
-            palette[3 * s + k] = (float)sc->surfaces[s].color[k];
     oct_writer_params wp;
-    memset(&wp, 0, sizeof wp);
-    wp.levels = levels;
-    build_cube(sc, wp.origin, &wp.edge);
-    wp.surface_count = (uint32_t)sc->nsurfaces;
-    wp.palette = palette;
+    build_writer_params(sc, levels, palette, &wp);
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
     build_params bp = {levels, method, threads, NULL, NULL};
