@@ -50,9 +50,9 @@
 #endif
 
 /* Rays in the exact-class run on random trees (levels 1-8) and deep trees. */
-#define RANDOM_TREE_RAYS (SANITIZED ? 60000ul : 960000ul)
-#define DEEP_RAYS (SANITIZED ? 6000ul : 100000ul)
-#define GENERAL_RAYS (SANITIZED ? 20000ul : 200000ul)
+#define RANDOM_TREE_RAYS (SANITIZED ? 240000ul : 960000ul)
+#define DEEP_RAYS (SANITIZED ? 25000ul : 100000ul)
+#define GENERAL_RAYS (SANITIZED ? 50000ul : 200000ul)
 
 #define FRAC_BITS 16 /* o is a multiple of 2^-FRAC_BITS */
 
@@ -864,7 +864,7 @@ static void test_watertight_shells(void **state)
             oct_tree *t = tree_util_build(levels, origin, 2.0, (const uint32_t(*)[3])v, n, NULL,
                                           NULL, 1, NULL);
             assert_non_null(t);
-            shoot_at_shell(t, (const uint32_t(*)[3])v, n, c, R, SANITIZED ? 60 : 400, &traced);
+            shoot_at_shell(t, (const uint32_t(*)[3])v, n, c, R, SANITIZED ? 150 : 400, &traced);
             tree_util_free(t);
             free(v);
         }
@@ -878,7 +878,7 @@ static void test_watertight_shells(void **state)
             tree_util_build(levels, origin, 2.0, (const uint32_t(*)[3])v, n, NULL, NULL, 1, NULL);
         assert_non_null(t);
         const double c[3] = {(lo + hi + 1) / 2.0, (lo + hi + 1) / 2.0 + 0.25, (lo + hi + 1) / 2.0};
-        shoot_at_shell(t, (const uint32_t(*)[3])v, n, c, 0.0, SANITIZED ? 60 : 400, &traced);
+        shoot_at_shell(t, (const uint32_t(*)[3])v, n, c, 0.0, SANITIZED ? 150 : 400, &traced);
         tree_util_free(t);
         free(v);
     }
