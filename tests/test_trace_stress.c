@@ -10,7 +10,8 @@
  *
  * Which rays must match exactly. The traversal rounds T = (k - o) * (1/d);
  * it is exact when 1/d is exact, i.e. d a power of two. The exact-class rays
- * therefore use direction components 0, -0, +-2^j (j in -3..3), or one tiny
+ * therefore use direction components 0, -0, +-2^j (j in -3..3; down to -30
+ * for near-axis rays starting inside), or one tiny
  * magnitude c in {1e-12, 1e-30} shared by all tiny axes of the ray (its
  * crossings lie beyond the cube, or compare against each other through the
  * same rounded 1/c, which keeps their order). For these rays the traversal's
@@ -389,6 +390,13 @@ static int exact_class_ray(uint32_t lim, const double P[3], double o[3], double 
         case 4: tb = -ldexp(floor(urand() * 64.0), -4); break; /* past P */
         default: tb = ldexp(floor(urand() * 64.0), -6); break;
         }
+    }
+    /* near-axis rays: one component 2^-4 .. 2^-30, from inside only (a
+     * re-based start is rounded, and 1/d would amplify that rounding) */
+    if (tb == 0.0 && irand(3) == 0) {
+        int a = (int)irand(3);
+        if (kind[a] == 1)
+            d[a] = (d[a] < 0 ? -1 : 1) * ldexp(1.0, -4 - (int)irand(27));
     }
     for (int a = 0; a < 3; a++) {
         if (kind[a] == 1)
