@@ -149,6 +149,11 @@ check_depth "$T/f.pfm" 21 21 0.5,0.5,1 0.5,0.5,0.5 0,1,0 60 "$sph" $vm
 view i "$T/s.oct" 15 15 0.5,0.5,0.5 0.5,0.5,1 0,1,0 120
 pfm_values "$T/i.pfm" 15 15 | awk '$1 ~ /inf|nan/ || $1 > 0.33 || $1 < 0.27 { bad = 1 } END { exit bad }' \
     || fail "from the sphere's centre every ray must hit the wall at t ~ 0.3"
+# eye inside an occupied voxel (on the sphere itself): trace.h's start rule,
+# every ray hits that voxel at t = 0
+view ov "$T/s.oct" 9 7 0.5,0.5,0.8 0.5,0.5,0.5 0,1,0 90
+pfm_values "$T/ov.pfm" 9 7 | awk '$1 != 0 { bad = 1 } END { exit bad }' \
+    || fail "an eye inside an occupied voxel must give t = 0 everywhere"
 # far away with a tiny fov (the sphere fills about half the frame)
 view far "$T/s.oct" 17 17 0.5,0.5,1000000 0.5,0.5,0.5 0,1,0 0.00005
 # (t near 10^6 in float32 has an ulp of 1/16)
