@@ -1,6 +1,5 @@
 /* rasterize: scene file -> sparse voxel octree (.oct), written atomically. */
 #include <errno.h>
-#include <fenv.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -90,20 +89,10 @@ static void print_summary(const char *out, unsigned levels, const build_stats *s
            (double)peak_rss_kib() / 1024.0);
 }
 
-/* DDA_FPE_TRAPS=1 (tests only): trap invalid operations (NaN from 0*inf,
- * inf-inf, sqrt(-1) ...) with SIGFPE, so that a stray NaN crashes the run
- * instead of reaching the output. Threads inherit the setting. */
-static void fpe_traps_from_env(void)
-{
-    const char *v = getenv("DDA_FPE_TRAPS");
-    if (v && strcmp(v, "1") == 0)
-        feenableexcept(FE_INVALID);
-}
-
 int main(int argc, char **argv)
 {
     diag_set_progname("rasterize");
-    fpe_traps_from_env();
+    diag_fpe_traps_from_env();
     const char *scene_path = NULL, *out_path = NULL;
     long levels = DEFAULT_LEVELS, threads = sysconf(_SC_NPROCESSORS_ONLN);
     build_method method = BUILD_INTERVAL;

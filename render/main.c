@@ -1,7 +1,6 @@
 /* render: map an .oct file once and ray trace every view asked for into PNG
  * (and PFM depth / normal) images. */
 #include <errno.h>
-#include <fenv.h>
 #include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
@@ -135,20 +134,10 @@ static void frame_cube(const oct_tree *t, views_view *v)
     }
 }
 
-/* DDA_FPE_TRAPS=1 (tests only): trap invalid operations (NaN from 0*inf,
- * inf-inf, sqrt(-1) ...) with SIGFPE, so that a stray NaN crashes the run
- * instead of reaching the output. Threads inherit the setting. */
-static void fpe_traps_from_env(void)
-{
-    const char *v = getenv("DDA_FPE_TRAPS");
-    if (v && strcmp(v, "1") == 0)
-        feenableexcept(FE_INVALID);
-}
-
 int main(int argc, char **argv)
 {
     diag_set_progname("render");
-    fpe_traps_from_env();
+    diag_fpe_traps_from_env();
     views_view base;
     views_defaults(&base);
     const char *oct_path = NULL, *views_path = NULL;
