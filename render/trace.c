@@ -2,6 +2,11 @@
 #include "render/trace.h"
 
 #include <math.h>
+#include <string.h>
+
+#if defined(__SSE4_1__)
+#include <smmintrin.h>
+#endif
 
 #include "format/oct_normal.h"
 
@@ -170,6 +175,22 @@ static double plane_time(const oct_tree *tree, const trace_ray *r, uint64_t idx,
     return t;
 }
 
+#if defined(__SSE4_1__)
+/* The same traversal with the three axes in SSE registers: (x, y) in one,
+ * (z, w) in the other, w a dummy lane whose exit time stays +inf. The
+ * arithmetic per lane is the scalar T() above, operation for operation. */
+typedef struct trace_frame_v {
+    __m128d txy, tzw; /* exit times of the node's cell */
+    uint64_t prefix;
+    uint32_t mask, ci;
+} trace_frame_v;
+
+/* lane masks for a 3-bit axis set */
+static const int32_t trace_lut[8][4] __attribute__((aligned(16))) = {
+    {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
+    {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+};
+
 int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
                        trace_hit *hit)
 {
@@ -180,63 +201,100 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     if (tree->node_count[0] == 0)
         return 0;
     const unsigned split = opts->split > levels ? levels : opts->split;
+    const int refine = opts->refine;
     const uint32_t max_steps = trace_max_steps(levels);
-    /* per axis: all ones when stepping up (the exit plane is the cell's top) */
-    const uint32_t up[3] = {r->sgn[0] > 0 ? ~0u : 0u, r->sgn[1] > 0 ? ~0u : 0u,
-                            r->sgn[2] > 0 ? ~0u : 0u};
-    uint64_t node[OCT_MAX_LEVELS]; /* node[d]: the depth-d ancestor of v */
-    unsigned valid = 0;            /* node[0..valid] hold for the current v */
-    node[0] = 0;
-    uint32_t v[3] = {r->v[0], r->v[1], r->v[2]};
-    double tc = 0.0; /* local time the ray entered v */
-    const double otx = r->ot[0], oty = r->ot[1], otz = r->ot[2];
-    const double ivx = r->inv[0], ivy = r->inv[1], ivz = r->inv[2];
     const double t_end = r->t_end;
+    const oct_group *const *groups = tree->groups;
+
+    double zo[4], zi[4], root[4];
+    unsigned far = 0;
+    const double nroot = (double)(UINT32_C(1) << levels);
+    for (int a = 0; a < 3; a++) {
+        if (r->active >> a & 1) {
+            zo[a] = r->ot[a];
+            zi[a] = r->inv[a];
+            far |= (r->sgn[a] > 0 ? 1u : 0u) << a;
+        } else {
+            zo[a] = (double)r->v[a] + 0.5;
+            zi[a] = INFINITY;
+            far |= 1u << a;
+        }
+        root[a] = ((far >> a & 1u ? nroot : 0.0) - zo[a]) * zi[a];
+    }
+    zo[3] = 0.0;
+    zi[3] = 0.0;
+    root[3] = INFINITY;
+    const __m128d ZOxy = _mm_loadu_pd(zo), ZOzw = _mm_loadu_pd(zo + 2);
+    const __m128d ZIxy = _mm_loadu_pd(zi), ZIzw = _mm_loadu_pd(zi + 2);
+
+    trace_frame_v fr[OCT_MAX_LEVELS];
+    __m128d TPxy = _mm_loadu_pd(root), TPzw = _mm_loadu_pd(root + 2);
+    uint32_t M = groups[0][0].mask[0];
+    uint64_t P = groups[0][0].base;
+    fr[0].txy = TPxy;
+    fr[0].tzw = TPzw;
+    fr[0].mask = M;
+    fr[0].prefix = P;
+    fr[0].ci = 0;
+    unsigned d = 0, ci = 0;
+    uint32_t size = UINT32_C(1) << levels;
+    __m128i V = _mm_setzero_si128();
+    __m128d Txy, Tzw, TC = _mm_setzero_pd();
+    double tc = 0.0;
     uint32_t steps = 0;
 
+    goto enter;
     for (;;) {
-        /* Vertical traverse (Figure 2) from the deepest still-valid ancestor
-         * down to the first empty child, or to the voxel. */
-        unsigned depth = valid;
-        uint32_t size;   /* edge, in voxels, of the cell to leave next */
-        int occupied = 0;
-        uint64_t vidx = 0;
-        for (;;) {
-            const unsigned bit = levels - 1 - depth;
-            const unsigned ci = ((v[0] >> bit) & 1u) | (((v[1] >> bit) & 1u) << 1) |
-                                (((v[2] >> bit) & 1u) << 2);
-            const oct_group *g = tree->groups[depth];
-            if (!((oct_node_mask(g, node[depth]) >> ci) & 1u)) {
-                /* Step one skips the whole empty cell while it is at depth
-                 * <= K; below K, step two walks single voxels. */
-                size = depth + 1 <= split ? UINT32_C(1) << bit : 1u;
+        const unsigned occ = M >> ci & 1u;
+        if (d < levels && (occ || d > split)) {
+            uint32_t Mn = 0;
+            uint64_t Pn = 0;
+            if (occ) {
+                const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+                const oct_group *gr = &groups[d][n >> 3];
+                const unsigned k = (unsigned)(n & 7u);
+                uint64_t masks;
+                memcpy(&masks, gr->mask, 8);
+                Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
+                Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+            }
+            fr[d].txy = Txy;
+            fr[d].tzw = Tzw;
+            fr[d].mask = Mn;
+            fr[d].prefix = Pn;
+            fr[d].ci = ci;
+            M = Mn;
+            P = Pn;
+            TPxy = Txy;
+            TPzw = Tzw;
+        enter:;
+            const uint32_t half = size >> 1;
+            const __m128i H = _mm_set1_epi32((int32_t)half);
+            const __m128i MID = _mm_add_epi32(V, H);
+            const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ZOxy), ZIxy);
+            const __m128d TMzw =
+                _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ZOzw), ZIzw);
+            const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw); /* near */
+            Txy = _mm_blendv_pd(TPxy, TMxy, Nxy);
+            Tzw = _mm_blendv_pd(TPzw, TMzw, Nzw);
+            ci = ((unsigned)_mm_movemask_pd(Nxy) | ((unsigned)_mm_movemask_pd(Nzw) & 1u) << 2) ^ far;
+            V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[ci])));
+            size = half;
+            d++;
+            continue;
+        }
+        if (occ) {
+            const uint64_t vidx = P + oct_popcount64(M & ((1u << ci) - 1u));
+            if (!refine) {
+                hit->hit = 1;
+                hit->voxel = vidx;
+                hit->t = r->t_base + tc;
                 break;
             }
-            uint64_t child = oct_child_index(g, node[depth], ci);
-            if (depth == levels - 1) {
-                occupied = 1;
-                vidx = child;
-                size = 1;
-                break;
-            }
-            node[++depth] = child;
-        }
-        valid = depth;
-        if (occupied && !opts->refine) {
-            hit->hit = 1;
-            hit->voxel = vidx;
-            hit->t = r->t_base + tc;
-            break;
-        }
-
-        /* Leave the cell: the nearest of its three exit planes, all from T(). */
-        const uint32_t cmask = ~(size - 1u);
-        const uint32_t lx = v[0] & cmask, ly = v[1] & cmask, lz = v[2] & cmask;
-        const uint32_t bx = lx + (size & up[0]), by = ly + (size & up[1]), bz = lz + (size & up[2]);
-        const double tx = (bx - otx) * ivx, ty = (by - oty) * ivy, tz = (bz - otz) * ivz;
-        double te = tx < ty ? tx : ty;
-        te = tz < te ? tz : te;
-        if (occupied) {
+            const __m128d m2 = _mm_min_pd(Txy, Tzw);
+            const double te = _mm_cvtsd_f64(_mm_min_sd(m2, _mm_unpackhi_pd(m2, m2)));
+            uint32_t v[4];
+            _mm_storeu_si128((__m128i *)v, V);
             double tp = plane_time(tree, r, vidx, v, tc, te < t_end ? te : t_end);
             if (tp >= 0.0) {
                 hit->hit = 1;
@@ -245,42 +303,240 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
                 break;
             }
         }
+
+        const __m128d m2 = _mm_min_pd(Txy, Tzw);
+        const __m128d TE = _mm_min_sd(m2, _mm_unpackhi_pd(m2, m2));
+        const double te = _mm_cvtsd_f64(TE);
         if (te >= t_end || ++steps > max_steps)
             break;
-        uint32_t nx, ny, nz;
-        if (size == 1u) {
-            /* step two: unit steps, only the axes whose plane comes first */
-            nx = tx == te ? (up[0] ? bx : bx - 1u) : v[0];
-            ny = ty == te ? (up[1] ? by : by - 1u) : v[1];
-            nz = tz == te ? (up[2] ? bz : bz - 1u) : v[2];
-        } else {
-            const uint32_t hi = size - 1u;
-            nx = tx == te ? (up[0] ? bx : bx - 1u)
-                 : (r->active & 1u) ? settle_at(r, 0, r->o[0] + te * r->d[0], lx, lx + hi, te)
-                                    : v[0];
-            ny = ty == te ? (up[1] ? by : by - 1u)
-                 : (r->active & 2u) ? settle_at(r, 1, r->o[1] + te * r->d[1], ly, ly + hi, te)
-                                    : v[1];
-            nz = tz == te ? (up[2] ? bz : bz - 1u)
-                 : (r->active & 4u) ? settle_at(r, 2, r->o[2] + te * r->d[2], lz, lz + hi, te)
-                                    : v[2];
+        const __m128d TEv = _mm_unpacklo_pd(TE, TE);
+        __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
+        unsigned smask = (unsigned)_mm_movemask_pd(Exy) | ((unsigned)_mm_movemask_pd(Ezw) & 1u) << 2;
+        while (~(ci ^ far) & smask) {
+            d--;
+            if (d == 0)
+                goto out;
+            size <<= 1;
+            V = _mm_andnot_si128(_mm_set1_epi32((int32_t)(size - 1u)), V);
+            Txy = TPxy;
+            Tzw = TPzw;
+            ci = fr[d].ci;
+            const trace_frame_v *pf = &fr[d - 1];
+            M = pf->mask;
+            P = pf->prefix;
+            TPxy = pf->txy;
+            TPzw = pf->tzw;
+            Exy = _mm_cmpeq_pd(Txy, TEv);
+            Ezw = _mm_cmpeq_pd(Tzw, TEv);
+            smask = (unsigned)_mm_movemask_pd(Exy) | ((unsigned)_mm_movemask_pd(Ezw) & 1u) << 2;
         }
-        /* Figure 3's XOR: the highest changed bit names the common ancestor. */
-        const uint32_t diff = (v[0] ^ nx) | (v[1] ^ ny) | (v[2] ^ nz);
-        const unsigned keep = levels - 1u - (31u - (unsigned)__builtin_clz(diff | 1u));
-        if (keep < valid)
-            valid = keep;
-        v[0] = nx;
-        v[1] = ny;
-        v[2] = nz;
+        ci ^= smask;
+        Txy = _mm_blendv_pd(Txy, TPxy, Exy);
+        Tzw = _mm_blendv_pd(Tzw, TPzw, Ezw);
+        V = _mm_xor_si128(V, _mm_and_si128(_mm_set1_epi32((int32_t)size),
+                                           _mm_load_si128((const __m128i *)trace_lut[smask])));
+        TC = TEv;
         tc = te;
     }
+out:;
+    uint32_t v[4];
+    _mm_storeu_si128((__m128i *)v, V);
     hit->xyz[0] = v[0];
     hit->xyz[1] = v[1];
     hit->xyz[2] = v[2];
     hit->steps = steps;
     return hit->hit;
 }
+#else
+/* One node of the descent stack: the node's child mask and first-child index,
+ * its cell's three exit-plane times, and its child index in its parent. */
+typedef struct trace_frame {
+    double tex[3];
+    uint64_t prefix; /* index in the next depth of the node's first child */
+    uint32_t mask;   /* child mask; 0 for an empty cell walked voxel by voxel */
+    uint32_t ci;     /* child index (x + 2y + 4z) of this node in its parent */
+} trace_frame;
+
+/* Stack-based traversal. The state is the current cell (depth d, child ci of
+ * its parent node, integer corner v, edge `size`), the time tc the ray entered
+ * it and its three exit-plane times; the ancestors are on a stack. A step
+ * leaves the cell through the axes whose exit time is the minimum te: when
+ * every such axis is on the near half of the parent, the next cell is the
+ * sibling across (one mask test); otherwise the parent is left too (pop) and
+ * the test repeats one level up — the paper's common ancestor, found without
+ * re-descending. Entering a non-empty cell chooses, per axis, the half the ray
+ * is in at tc by comparing tc with the mid-plane time T(mid): that is the tie
+ * rule of trace.h read bit by bit (T is monotone in k), so entry voxels are
+ * never estimated from positions. Every time is T_a(k) = (k - o_a) * inv_a of
+ * an integer plane, as before. Zero axes use o' = v + 1/2, inv' = +inf, so
+ * that T(k) = -inf for k <= v and +inf above: the ray stays in voxel v. */
+int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       trace_hit *hit)
+{
+    const unsigned levels = tree->levels;
+    hit->hit = 0;
+    hit->t = INFINITY;
+    hit->steps = 0;
+    if (tree->node_count[0] == 0)
+        return 0;
+    const unsigned split = opts->split > levels ? levels : opts->split;
+    const int refine = opts->refine;
+    const uint32_t max_steps = trace_max_steps(levels);
+    const double t_end = r->t_end;
+    const oct_group *const *groups = tree->groups;
+
+    /* plane-time parameters per axis; far: the child bit of the far half */
+    double zo[3], zi[3];
+    unsigned far = 0;
+    for (int a = 0; a < 3; a++) {
+        if (r->active >> a & 1) {
+            zo[a] = r->ot[a];
+            zi[a] = r->inv[a];
+            far |= (r->sgn[a] > 0 ? 1u : 0u) << a;
+        } else {
+            zo[a] = (double)r->v[a] + 0.5;
+            zi[a] = INFINITY;
+            far |= 1u << a;
+        }
+    }
+    const double zox = zo[0], zoy = zo[1], zoz = zo[2];
+    const double zix = zi[0], ziy = zi[1], ziz = zi[2];
+    const unsigned fx = far & 1u, fy = far >> 1 & 1u, fz = far >> 2 & 1u;
+    const double nroot = (double)(UINT32_C(1) << levels);
+
+    trace_frame fr[OCT_MAX_LEVELS];
+    /* the current cell's parent node (fr[d - 1], kept in registers) */
+    double tpx = ((fx ? nroot : 0.0) - zox) * zix;
+    double tpy = ((fy ? nroot : 0.0) - zoy) * ziy;
+    double tpz = ((fz ? nroot : 0.0) - zoz) * ziz;
+    uint32_t M = groups[0][0].mask[0];
+    uint64_t P = groups[0][0].base;
+    fr[0].tex[0] = tpx;
+    fr[0].tex[1] = tpy;
+    fr[0].tex[2] = tpz;
+    fr[0].mask = M;
+    fr[0].prefix = P;
+    fr[0].ci = 0;
+    /* the current cell */
+    unsigned d = 0, ci = 0;
+    uint32_t vx = 0, vy = 0, vz = 0, size = UINT32_C(1) << levels;
+    double tx, ty, tz, tc = 0.0;
+    uint32_t steps = 0;
+
+    goto enter;
+    for (;;) {
+        const unsigned occ = M >> ci & 1u;
+        if (d < levels && (occ || d > split)) {
+            /* the cell becomes the parent: push it, then enter its child */
+            uint32_t Mn = 0;
+            uint64_t Pn = 0;
+            if (occ) {
+                const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+                const oct_group *gr = &groups[d][n >> 3];
+                const unsigned k = (unsigned)(n & 7u);
+                uint64_t masks;
+                memcpy(&masks, gr->mask, 8);
+                Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
+                Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+            }
+            fr[d].tex[0] = tx;
+            fr[d].tex[1] = ty;
+            fr[d].tex[2] = tz;
+            fr[d].mask = Mn;
+            fr[d].prefix = Pn;
+            fr[d].ci = ci;
+            M = Mn;
+            P = Pn;
+            tpx = tx;
+            tpy = ty;
+            tpz = tz;
+        enter:;
+            /* the child the ray is in at tc: per axis, the far half when the
+             * mid plane is crossed at or before tc */
+            const uint32_t half = size >> 1;
+            const double tmx = ((double)(vx + half) - zox) * zix;
+            const double tmy = ((double)(vy + half) - zoy) * ziy;
+            const double tmz = ((double)(vz + half) - zoz) * ziz;
+            const unsigned nx = tmx > tc, ny = tmy > tc, nz = tmz > tc; /* near halves */
+            tx = nx ? tmx : tpx;
+            ty = ny ? tmy : tpy;
+            tz = nz ? tmz : tpz;
+            const unsigned bx = nx ^ fx, by = ny ^ fy, bz = nz ^ fz;
+            vx |= (0u - bx) & half;
+            vy |= (0u - by) & half;
+            vz |= (0u - bz) & half;
+            ci = bx | by << 1 | bz << 2;
+            size = half;
+            d++;
+            continue;
+        }
+        if (occ) {
+            /* a voxel */
+            const uint64_t vidx = P + oct_popcount64(M & ((1u << ci) - 1u));
+            if (!refine) {
+                hit->hit = 1;
+                hit->voxel = vidx;
+                hit->t = r->t_base + tc;
+                break;
+            }
+            double te = tx < ty ? tx : ty;
+            te = tz < te ? tz : te;
+            const uint32_t v[3] = {vx, vy, vz};
+            double tp = plane_time(tree, r, vidx, v, tc, te < t_end ? te : t_end);
+            if (tp >= 0.0) {
+                hit->hit = 1;
+                hit->voxel = vidx;
+                hit->t = r->t_base + tp;
+                break;
+            }
+        }
+
+        /* leave the cell through its nearest exit planes */
+        double te = tx < ty ? tx : ty;
+        te = tz < te ? tz : te;
+        if (te >= t_end || ++steps > max_steps)
+            break;
+        unsigned smask = (unsigned)(tx == te) | (unsigned)(ty == te) << 1 |
+                         (unsigned)(tz == te) << 2;
+        /* an axis stepped on the far half leaves the parent: go up */
+        while (~(ci ^ far) & smask) {
+            d--;
+            if (d == 0)
+                goto out; /* the root is left (te >= t_end caught it first) */
+            size <<= 1;
+            vx &= ~(size - 1u);
+            vy &= ~(size - 1u);
+            vz &= ~(size - 1u);
+            tx = tpx;
+            ty = tpy;
+            tz = tpz;
+            ci = fr[d].ci;
+            const trace_frame *pf = &fr[d - 1];
+            M = pf->mask;
+            P = pf->prefix;
+            tpx = pf->tex[0];
+            tpy = pf->tex[1];
+            tpz = pf->tex[2];
+            smask = (unsigned)(tx == te) | (unsigned)(ty == te) << 1 | (unsigned)(tz == te) << 2;
+        }
+        /* the sibling across the stepped axes: their exits are the parent's */
+        ci ^= smask;
+        tx = smask & 1u ? tpx : tx;
+        ty = smask & 2u ? tpy : ty;
+        tz = smask & 4u ? tpz : tz;
+        vx ^= (0u - (smask & 1u)) & size;
+        vy ^= (0u - (smask >> 1 & 1u)) & size;
+        vz ^= (0u - (smask >> 2 & 1u)) & size;
+        tc = te;
+    }
+out:
+    hit->xyz[0] = vx;
+    hit->xyz[1] = vy;
+    hit->xyz[2] = vz;
+    hit->steps = steps;
+    return hit->hit;
+}
+#endif
 
 int trace_ray_cast(const oct_tree *tree, const trace_opts *opts, const double eye[3],
                    const double dir[3], trace_hit *hit)
