@@ -71,6 +71,7 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     const double scale = n / tree->edge;
     double o[3], d[3];
     unsigned active = 0;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         if (!isfinite(eye[a]) || !isfinite(dir[a]))
             return 0;
@@ -98,6 +99,7 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
      * position only. */
     double t0 = -INFINITY, t1 = INFINITY;
     int entry = -1;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         if (!(active >> a & 1)) {
             if (o[a] < 0.0 || o[a] > n)
@@ -120,7 +122,8 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
      * coordinates of the grid's magnitude whatever the eye's distance. */
     if (t0 > 0.0) {
         r->t_base = t0;
-        for (int a = 0; a < 3; a++) {
+    #pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
             double p = o[a];
             if (a == entry)
                 p = r->sgn[a] > 0 ? 0.0 : n;
@@ -130,10 +133,12 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
         }
     } else {
         r->t_base = 0.0;
-        for (int a = 0; a < 3; a++)
+    #pragma GCC unroll 3
+    for (int a = 0; a < 3; a++)
             r->o[a] = o[a];
     }
     double t_end = INFINITY;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         r->ot[a] = (active >> a & 1) ? r->o[a] : -INFINITY;
         if (active >> a & 1) {
@@ -145,6 +150,7 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     if (!(t_end > 0.0))
         return 0;
     r->t_end = t_end;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         r->v[a] = (active >> a & 1) ? settle_at(r, a, r->o[a], 0, nvox - 1, 0.0)
                                     : floor_clamp(r->o[a], 0, nvox - 1);
@@ -245,29 +251,55 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
 
     goto enter;
     for (;;) {
-        const unsigned occ = M >> ci & 1u;
-        if (d < levels && (occ || d > split)) {
-            uint32_t Mn = 0;
-            uint64_t Pn = 0;
-            if (occ) {
-                const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
-                const oct_group *gr = &groups[d][n >> 3];
-                const unsigned k = (unsigned)(n & 7u);
-                uint64_t masks;
-                memcpy(&masks, gr->mask, 8);
-                Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
-                Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+        uint32_t Mn;
+        uint64_t Pn;
+        if (M >> ci & 1u) {
+            const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+            if (d == levels) {
+                /* a voxel */
+                if (!refine) {
+                    hit->hit = 1;
+                    hit->voxel = n;
+                    hit->t = r->t_base + tc;
+                    break;
+                }
+                const __m128d m2 = _mm_min_pd(Txy, Tzw);
+                const double te = _mm_cvtsd_f64(_mm_min_sd(m2, _mm_unpackhi_pd(m2, m2)));
+                uint32_t v[4];
+                _mm_storeu_si128((__m128i *)v, V);
+                double tp = plane_time(tree, r, n, v, tc, te < t_end ? te : t_end);
+                if (tp >= 0.0) {
+                    hit->hit = 1;
+                    hit->voxel = n;
+                    hit->t = r->t_base + tp;
+                    break;
+                }
+                goto step;
             }
-            fr[d].txy = Txy;
-            fr[d].tzw = Tzw;
-            fr[d].mask = Mn;
-            fr[d].prefix = Pn;
-            fr[d].ci = ci;
-            M = Mn;
-            P = Pn;
-            TPxy = Txy;
-            TPzw = Tzw;
-        enter:;
+            const oct_group *gr = &groups[d][n >> 3];
+            const unsigned k = (unsigned)(n & 7u);
+            uint64_t masks;
+            memcpy(&masks, gr->mask, 8);
+            Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
+            Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+        } else if (d > split && d < levels) {
+            Mn = 0; /* below K: walk the empty cell voxel by voxel */
+            Pn = 0;
+        } else {
+            goto step;
+        }
+        /* the cell becomes the parent: push it, then enter its child */
+        fr[d].txy = Txy;
+        fr[d].tzw = Tzw;
+        fr[d].mask = Mn;
+        fr[d].prefix = Pn;
+        fr[d].ci = ci;
+        M = Mn;
+        P = Pn;
+        TPxy = Txy;
+        TPzw = Tzw;
+    enter:;
+        {
             const uint32_t half = size >> 1;
             const __m128i H = _mm_set1_epi32((int32_t)half);
             const __m128i MID = _mm_add_epi32(V, H);
@@ -283,27 +315,7 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             d++;
             continue;
         }
-        if (occ) {
-            const uint64_t vidx = P + oct_popcount64(M & ((1u << ci) - 1u));
-            if (!refine) {
-                hit->hit = 1;
-                hit->voxel = vidx;
-                hit->t = r->t_base + tc;
-                break;
-            }
-            const __m128d m2 = _mm_min_pd(Txy, Tzw);
-            const double te = _mm_cvtsd_f64(_mm_min_sd(m2, _mm_unpackhi_pd(m2, m2)));
-            uint32_t v[4];
-            _mm_storeu_si128((__m128i *)v, V);
-            double tp = plane_time(tree, r, vidx, v, tc, te < t_end ? te : t_end);
-            if (tp >= 0.0) {
-                hit->hit = 1;
-                hit->voxel = vidx;
-                hit->t = r->t_base + tp;
-                break;
-            }
-        }
-
+    step:;
         const __m128d m2 = _mm_min_pd(Txy, Tzw);
         const __m128d TE = _mm_min_sd(m2, _mm_unpackhi_pd(m2, m2));
         const double te = _mm_cvtsd_f64(TE);
