@@ -183,7 +183,9 @@ static double plane_time(const oct_tree *tree, const trace_ray *r, uint64_t idx,
 
 #if defined(__SSE4_1__)
 /* The same traversal with the three axes in SSE registers: (x, y) in one,
- * (z, w) in the other, w a dummy lane whose exit time stays +inf. The
+ * (z, w) in the other, w a dummy lane (o = inv = 0) whose exit time stays
+ * +inf: its mid-plane time is 0, never > tc, so it never picks a near half,
+ * and it never equals a step time te < t_end, so its mask bits are 0. The
  * arithmetic per lane is the scalar T() above, operation for operation. */
 typedef struct trace_frame_v {
     __m128d txy, tzw; /* exit times of the node's cell */
@@ -309,7 +311,7 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw); /* near */
             Txy = _mm_blendv_pd(TPxy, TMxy, Nxy);
             Tzw = _mm_blendv_pd(TPzw, TMzw, Nzw);
-            ci = ((unsigned)_mm_movemask_pd(Nxy) | ((unsigned)_mm_movemask_pd(Nzw) & 1u) << 2) ^ far;
+            ci = ((unsigned)_mm_movemask_pd(Nxy) | (unsigned)_mm_movemask_pd(Nzw) << 2) ^ far;
             V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[ci])));
             size = half;
             d++;
@@ -317,13 +319,12 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
         }
     step:;
         const __m128d m2 = _mm_min_pd(Txy, Tzw);
-        const __m128d TE = _mm_min_sd(m2, _mm_unpackhi_pd(m2, m2));
-        const double te = _mm_cvtsd_f64(TE);
+        const __m128d TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)); /* te in both lanes */
+        const double te = _mm_cvtsd_f64(TEv);
         if (te >= t_end || ++steps > max_steps)
             break;
-        const __m128d TEv = _mm_unpacklo_pd(TE, TE);
         __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
-        unsigned smask = (unsigned)_mm_movemask_pd(Exy) | ((unsigned)_mm_movemask_pd(Ezw) & 1u) << 2;
+        unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
         while (~(ci ^ far) & smask) {
             d--;
             if (d == 0)
@@ -340,7 +341,7 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             TPzw = pf->tzw;
             Exy = _mm_cmpeq_pd(Txy, TEv);
             Ezw = _mm_cmpeq_pd(Tzw, TEv);
-            smask = (unsigned)_mm_movemask_pd(Exy) | ((unsigned)_mm_movemask_pd(Ezw) & 1u) << 2;
+            smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
         }
         ci ^= smask;
         Txy = _mm_blendv_pd(Txy, TPxy, Exy);
