@@ -15,9 +15,6 @@ uint32_t trace_max_steps(unsigned levels)
     return 3u * (UINT32_C(1) << levels) + levels;
 }
 
-/* The voxel k in [lo, hi] along `axis` that the ray occupies at local time t
- * (trace.h's tie rule), starting from the estimate k. T is monotone in k, so
- * at most a few moves; the bounds keep it inside the cell being left. */
 /* floor(x) clamped to [lo, hi] and converted without overflow. */
 static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
 {
@@ -28,39 +25,6 @@ static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
         return hi;
     return (uint32_t)f;
 }
-
-static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, uint32_t hi, double t);
-
-/* The same from the position p = o + t*d on that axis. Fast path: when p is
- * more than SETTLE_MARGIN voxel inside a voxel of [lo, hi], that voxel is
- * the answer: p and T() differ by far less (about 2^-31 voxel at level 20,
- * see RENDER.md), so no T() evaluation can disagree. Otherwise settle. */
-#define SETTLE_MARGIN 1e-6
-static inline uint32_t settle_at(const trace_ray *r, int axis, double p, uint32_t lo, uint32_t hi,
-                                 double t)
-{
-    double f = floor(p), frac = p - f;
-    if (f >= (double)lo && f <= (double)hi && frac > SETTLE_MARGIN && frac < 1.0 - SETTLE_MARGIN)
-        return (uint32_t)f;
-    return settle(r, axis, floor_clamp(p, lo, hi), lo, hi, t);
-}
-
-static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, uint32_t hi, double t)
-{
-    if (r->sgn[axis] > 0) {
-        while (k < hi && trace_plane_time(r, axis, (double)k + 1.0) <= t)
-            k++;
-        while (k > lo && trace_plane_time(r, axis, (double)k) > t)
-            k--;
-    } else {
-        while (k > lo && trace_plane_time(r, axis, (double)k) <= t)
-            k--;
-        while (k < hi && trace_plane_time(r, axis, (double)k + 1.0) > t)
-            k++;
-    }
-    return k;
-}
-
 
 int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r)
 {
@@ -152,8 +116,7 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     r->t_end = t_end;
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        r->v[a] = (active >> a & 1) ? settle_at(r, a, r->o[a], 0, nvox - 1, 0.0)
-                                    : floor_clamp(r->o[a], 0, nvox - 1);
+        r->v[a] = (active >> a & 1) ? 0u : floor_clamp(r->o[a], 0, nvox - 1);
     }
     return 1;
 }

@@ -59,7 +59,9 @@ typedef struct trace_ray {
     double t_base;    /* t of the local start point on the caller's ray */
     double t_end;     /* local t at which the ray leaves the root cube */
     int32_t sgn[3];   /* +1 or -1; +1 on a zero axis */
-    uint32_t v[3];    /* voxel occupied at local t = 0 */
+    uint32_t v[3];    /* zero axis: the voxel the ray stays in (floor(o) clamped to
+                         N - 1); 0 on other axes, whose start voxel the
+                         traversal finds from T() */
     unsigned active;  /* bit a set when axis a has a non-zero direction */
 } trace_ray;
 
