@@ -180,16 +180,12 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     double zo[4], zi[4], root[4];
     unsigned far = 0;
     const double nroot = (double)(UINT32_C(1) << levels);
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        if (r->active >> a & 1) {
-            zo[a] = r->ot[a];
-            zi[a] = r->inv[a];
-            far |= (r->sgn[a] > 0 ? 1u : 0u) << a;
-        } else {
-            zo[a] = (double)r->v[a] + 0.5;
-            zi[a] = INFINITY;
-            far |= 1u << a;
-        }
+        const int act = r->active >> a & 1;
+        zo[a] = act ? r->ot[a] : (double)r->v[a] + 0.5;
+        zi[a] = act ? r->inv[a] : INFINITY;
+        far |= (r->sgn[a] > 0 ? 1u : 0u) << a; /* sgn is +1 on a zero axis */
         root[a] = ((far >> a & 1u ? nroot : 0.0) - zo[a]) * zi[a];
     }
     zo[3] = 0.0;
