@@ -1,7 +1,7 @@
 /* trace: the two-step discrete ray traversal of an oct_tree (Stolte & Caubet,
  * sections 3-4): clip to the root cube, skip empty cells down to the split
  * depth K, then walk voxel by voxel, looking occupancy up from the common
- * ancestor found by the XOR of old and new voxel coordinates.
+ * ancestor, kept on a stack (see RENDER.md, "Traversal").
  *
  * Coordinates. The ray is mapped to grid coordinates, where the root cube is
  * [0, N]^3 with N = 2^L voxels a side: g = (p - origin) * N / edge. The
