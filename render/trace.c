@@ -162,6 +162,57 @@ static const int32_t trace_lut[8][4] __attribute__((aligned(16))) = {
     {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
 };
 
+/* Step two below K: walks the empty cell (corner V, edge size > 1, entered
+ * at tc with exit times Txy, Tzw) voxel by voxel. Its entry voxel is found
+ * bit by bit as on entry into any cell; then a unit DDA whose exit times are
+ * T of the voxel's far faces runs until the cell's own exit time, where the
+ * caller leaves the cell as above K: the same voxels, times and step count as
+ * walking the cell as a subtree with an all-empty mask. Returns the step
+ * count (steps plus the voxel steps taken), max_steps + 1 when the bound is
+ * passed. Out of line: the default K = L never calls it. */
+static __attribute__((noinline)) uint32_t
+trace_walk_empty(__m128i V, uint32_t size, __m128d TC, __m128d Wxy, __m128d Wzw, __m128d ZOxy,
+                 __m128d ZOzw, __m128d ZIxy, __m128d ZIzw, double zoz, double ziz, unsigned far,
+                 uint32_t steps, uint32_t max_steps)
+{
+    const __m128d c2 = _mm_min_pd(Wxy, Wzw);
+    const double te_cell = _mm_cvtsd_f64(_mm_min_pd(c2, _mm_shuffle_pd(c2, c2, 1)));
+    while (size > 1) {
+        const uint32_t half = size >> 1;
+        const __m128i H = _mm_set1_epi32((int32_t)half);
+        const __m128i MID = _mm_add_epi32(V, H);
+        const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ZOxy), ZIxy);
+        const __m128d TMzw =
+            _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ZOzw), ZIzw);
+        const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw);
+        Wxy = _mm_blendv_pd(Wxy, TMxy, Nxy);
+        Wzw = _mm_blendv_pd(Wzw, TMzw, Nzw);
+        const unsigned b = ((unsigned)_mm_movemask_pd(Nxy) | (unsigned)_mm_movemask_pd(Nzw) << 2) ^ far;
+        V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[b])));
+        size = half;
+    }
+    /* far-face offsets and unit moves per lane; the dummy lane w uses
+     * o = -1/2, inv = +inf so that its exit time is +inf */
+    const __m128i FARV = _mm_setr_epi32((int32_t)(far & 1u), (int32_t)(far >> 1 & 1u),
+                                        (int32_t)(far >> 2 & 1u), 0);
+    const __m128i DIRV = _mm_sub_epi32(_mm_add_epi32(FARV, FARV), _mm_set1_epi32(1));
+    const __m128d WZOzw = _mm_setr_pd(zoz, -0.5), WZIzw = _mm_setr_pd(ziz, INFINITY);
+    for (;;) {
+        const __m128d w2 = _mm_min_pd(Wxy, Wzw);
+        const __m128d WEv = _mm_min_pd(w2, _mm_shuffle_pd(w2, w2, 1));
+        if (_mm_cvtsd_f64(WEv) >= te_cell)
+            return steps;
+        if (++steps > max_steps)
+            return steps;
+        const unsigned wm = (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Wxy, WEv)) |
+                            (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Wzw, WEv)) << 2;
+        V = _mm_add_epi32(V, _mm_and_si128(DIRV, _mm_load_si128((const __m128i *)trace_lut[wm])));
+        const __m128i F = _mm_add_epi32(V, FARV);
+        Wxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(F), ZOxy), ZIxy);
+        Wzw = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(F, F)), WZOzw), WZIzw);
+    }
+}
+
 int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
                        trace_hit *hit)
 {
@@ -193,12 +244,6 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     root[3] = INFINITY;
     const __m128d ZOxy = _mm_loadu_pd(zo), ZOzw = _mm_loadu_pd(zo + 2);
     const __m128d ZIxy = _mm_loadu_pd(zi), ZIzw = _mm_loadu_pd(zi + 2);
-    /* the voxel walk below K: far-face offsets and unit moves per lane; its
-     * dummy lane w uses o = -1/2, inv = +inf so that its exit time is +inf */
-    const __m128i FARV = _mm_setr_epi32((int32_t)(far & 1u), (int32_t)(far >> 1 & 1u),
-                                        (int32_t)(far >> 2 & 1u), 0);
-    const __m128i DIRV = _mm_sub_epi32(_mm_add_epi32(FARV, FARV), _mm_set1_epi32(1));
-    const __m128d WZOzw = _mm_setr_pd(zo[2], -0.5), WZIzw = _mm_setr_pd(zi[2], INFINITY);
 
     trace_frame_v fr[OCT_MAX_LEVELS];
     __m128d TPxy = _mm_loadu_pd(root), TPzw = _mm_loadu_pd(root + 2);
@@ -250,50 +295,11 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
             Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
         } else if (d > split && d < levels) {
-            /* Step two, below K: walk the empty cell voxel by voxel. Its
-             * entry voxel is found bit by bit as on entry above; then a unit
-             * DDA whose exit times are T of the voxel's far faces runs until
-             * the cell's own exit time, where the cell is left as above K
-             * (the same cells, times and step count as walking the cell as
-             * a subtree with an all-empty mask). */
-            const __m128i CV = V;
-            const uint32_t csize = size;
-            const unsigned cci = ci;
-            const __m128d c2 = _mm_min_pd(Txy, Tzw);
-            const double te_cell = _mm_cvtsd_f64(_mm_min_pd(c2, _mm_shuffle_pd(c2, c2, 1)));
-            __m128d Wxy = Txy, Wzw = Tzw;
-            while (size > 1) {
-                const uint32_t half = size >> 1;
-                const __m128i H = _mm_set1_epi32((int32_t)half);
-                const __m128i MID = _mm_add_epi32(V, H);
-                const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ZOxy), ZIxy);
-                const __m128d TMzw =
-                    _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ZOzw), ZIzw);
-                const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw);
-                Wxy = _mm_blendv_pd(Wxy, TMxy, Nxy);
-                Wzw = _mm_blendv_pd(Wzw, TMzw, Nzw);
-                const unsigned b =
-                    ((unsigned)_mm_movemask_pd(Nxy) | (unsigned)_mm_movemask_pd(Nzw) << 2) ^ far;
-                V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[b])));
-                size = half;
-            }
-            for (;;) {
-                const __m128d w2 = _mm_min_pd(Wxy, Wzw);
-                const __m128d WEv = _mm_min_pd(w2, _mm_shuffle_pd(w2, w2, 1));
-                if (_mm_cvtsd_f64(WEv) >= te_cell)
-                    break;
-                if (++steps > max_steps)
-                    goto out;
-                const unsigned wm = (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Wxy, WEv)) |
-                                    (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Wzw, WEv)) << 2;
-                V = _mm_add_epi32(V, _mm_and_si128(DIRV, _mm_load_si128((const __m128i *)trace_lut[wm])));
-                const __m128i F = _mm_add_epi32(V, FARV);
-                Wxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(F), ZOxy), ZIxy);
-                Wzw = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(F, F)), WZOzw), WZIzw);
-            }
-            V = CV;
-            size = csize;
-            ci = cci;
+            /* step two, below K: walk the empty cell voxel by voxel */
+            steps = trace_walk_empty(V, size, TC, Txy, Tzw, ZOxy, ZOzw, ZIxy, ZIzw, zo[2], zi[2], far,
+                                     steps, max_steps);
+            if (steps > max_steps)
+                goto out;
             goto step;
         } else {
             goto step;
