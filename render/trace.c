@@ -353,9 +353,14 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             P = pf->prefix;
             TPxy = pf->txy;
             TPzw = pf->tzw;
-            Exy = _mm_cmpeq_pd(Txy, TEv);
-            Ezw = _mm_cmpeq_pd(Tzw, TEv);
-            smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+            /* One stepped axis a, on the far half: the parent's exit on a is
+             * the same plane (= te) and its other exits are later, so its
+             * stepped set is {a} again; only ties need comparing anew. */
+            if (smask & (smask - 1u)) {
+                Exy = _mm_cmpeq_pd(Txy, TEv);
+                Ezw = _mm_cmpeq_pd(Tzw, TEv);
+                smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+            }
         }
         ci ^= smask;
         Txy = _mm_blendv_pd(Txy, TPxy, Exy);
