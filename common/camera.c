@@ -65,15 +65,17 @@ camera_err camera_init(camera *c, const double eye[3], const double target[3], c
     return CAMERA_OK;
 }
 
-void camera_ray(const camera *c, uint32_t i, uint32_t j, double dir[3])
+void camera_ray_uv(const camera *c, double u, double v, double dir[3])
 {
-    const double w = (double)c->width, h = (double)c->height;
-    double u = (2.0 * ((double)i + 0.5) / w - 1.0) * c->h * w / h;
-    double v = (1.0 - 2.0 * ((double)j + 0.5) / h) * c->h;
     double d[3];
     for (int a = 0; a < 3; a++)
         d[a] = c->forward[a] + u * c->right[a] + v * c->up[a];
     double n = norm3(d);
     for (int a = 0; a < 3; a++)
         dir[a] = d[a] / n;
+}
+
+void camera_ray(const camera *c, uint32_t i, uint32_t j, double dir[3])
+{
+    camera_ray_uv(c, camera_u(c, i), camera_v(c, j), dir);
 }

@@ -33,4 +33,21 @@ camera_err camera_init(camera *c, const double eye[3], const double target[3], c
  * to bottom, exactly as INTERFACE.md writes it. */
 void camera_ray(const camera *c, uint32_t i, uint32_t j, double dir[3]);
 
+/* camera_ray in pieces, for renderers that reuse u along a column and v
+ * along a row: camera_ray(c, i, j, d) is camera_ray_uv(c, camera_u(c, i),
+ * camera_v(c, j), d), bit for bit. */
+static inline double camera_u(const camera *c, uint32_t i)
+{
+    const double w = (double)c->width, h = (double)c->height;
+    return (2.0 * ((double)i + 0.5) / w - 1.0) * c->h * w / h;
+}
+
+static inline double camera_v(const camera *c, uint32_t j)
+{
+    const double h = (double)c->height;
+    return (1.0 - 2.0 * ((double)j + 0.5) / h) * c->h;
+}
+
+void camera_ray_uv(const camera *c, double u, double v, double dir[3]);
+
 #endif

@@ -7,6 +7,7 @@
 #include <stdatomic.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "common/image.h"
 
@@ -15,6 +16,58 @@ typedef struct frame_shared {
     uint32_t tiles_x, tiles_y;
     atomic_uint_fast64_t next, done, hits, steps;
 } frame_shared;
+
+/* image_srgb8 without pow: the code value is the number of thresholds at or
+ * below the input, where threshold k is the least float whose image_srgb8
+ * is >= k (found by bisection over the float bit patterns, image_srgb8 being
+ * monotone). Bit for bit image_srgb8, NaN and out-of-range inputs included;
+ * tests/test_frame.c compares the two over every float in [0, 1]. */
+static float srgb_threshold[256];
+static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
+
+static float float_of_bits(uint32_t b)
+{
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+static void srgb_init(void)
+{
+    srgb_threshold[0] = -INFINITY;
+    for (unsigned k = 1; k < 256; k++) {
+        uint32_t lo = 0, hi = 0x3f800000u; /* image_srgb8(1.0f) == 255 >= k */
+        while (lo < hi) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (image_srgb8(float_of_bits(mid)) >= k)
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        srgb_threshold[k] = float_of_bits(lo);
+    }
+}
+
+uint8_t frame_srgb8(float x)
+{
+    pthread_once(&srgb_once, srgb_init);
+    unsigned k = 0;
+    for (unsigned step = 128; step; step >>= 1)
+        if (x >= srgb_threshold[k + step])
+            k += step;
+    return (uint8_t)k;
+}
+
+static inline uint8_t srgb8_fast(float x)
+{
+    if (!(x > 0.0f)) /* misses on a black background: no search */
+        return 0;
+    unsigned k = 0;
+#pragma GCC unroll 8
+    for (unsigned step = 128; step; step >>= 1)
+        k += x >= srgb_threshold[k + step] ? step : 0;
+    return (uint8_t)k;
+}
 
 static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t *hits,
                         uint64_t *steps)
@@ -26,17 +79,22 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
         i1 = cam->width;
     if (j1 > cam->height)
         j1 = cam->height;
+    const uint32_t i0 = tx * FRAME_TILE;
+    double us[FRAME_TILE];
+    for (uint32_t i = i0; i < i1; i++)
+        us[i - i0] = camera_u(cam, i);
     for (uint32_t j = ty * FRAME_TILE; j < j1; j++) {
-        for (uint32_t i = tx * FRAME_TILE; i < i1; i++) {
+        const double v = camera_v(cam, j);
+        for (uint32_t i = i0; i < i1; i++) {
             double dir[3];
-            camera_ray(cam, i, j, dir);
+            camera_ray_uv(cam, us[i - i0], v, dir);
             trace_hit h;
             trace_ray_cast(job->tree, &job->opts, cam->eye, dir, &h);
             float rgb[3], n[3];
             shade_hit(job->tree, &job->shade, &h, dir, rgb, n);
             size_t px = (size_t)j * w + i;
             for (int a = 0; a < 3; a++)
-                job->rgb[3 * px + (size_t)a] = image_srgb8(rgb[a]);
+                job->rgb[3 * px + (size_t)a] = srgb8_fast(rgb[a]);
             if (job->depth)
                 job->depth[px] = h.t > FLT_MAX ? (isinf(h.t) ? INFINITY : FLT_MAX) : (float)h.t;
             if (job->normals)
@@ -75,6 +133,7 @@ static void *worker(void *arg)
 
 int frame_render(const frame_job *job, frame_stats *stats)
 {
+    pthread_once(&srgb_once, srgb_init);
     frame_shared sh;
     sh.job = job;
     sh.tiles_x = (job->cam->width + FRAME_TILE - 1) / FRAME_TILE;

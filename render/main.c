@@ -25,7 +25,7 @@ static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
     "              [--split K] [--refine] [--light X,Y,Z] [--background R,G,B]\n"
-    "              [--threads N] [--info] [-q]\n"
+    "              [--threads N] [--trust] [--info] [-q]\n"
     "       render FILE.oct --views VIEWS_FILE [options]\n"
     "       render FILE.oct -o 'frame_%04d.png' --orbit N [options]\n"
     "       render --info FILE.oct\n";
@@ -48,6 +48,8 @@ static const char help_text[] =
     "  --views FILE        one view a line, same options as above ('#' comments)\n"
     "  --orbit N           N views on a circle around the target; -o is a pattern\n"
     "                      with one integer conversion, e.g. frame_%04d.png\n"
+    "  --trust             skip the file's CRC-32 checks (a fixed cost per file); the\n"
+    "                      structure is still validated in full\n"
     "  --info              print a summary of FILE.oct\n"
     "  -q                  no per-view timing lines\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
@@ -142,7 +144,7 @@ int main(int argc, char **argv)
     views_defaults(&base);
     const char *oct_path = NULL, *views_path = NULL;
     long orbit = 0, split = -1, threads = 0;
-    int refine = 0, info = 0, quiet = 0, status = EXIT_OK;
+    int refine = 0, info = 0, quiet = 0, trust = 0, status = EXIT_OK;
     double light[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
     int has_light = 0;
     char msg[512];
@@ -175,6 +177,10 @@ int main(int argc, char **argv)
         }
         if (strcmp(a, "--info") == 0) {
             info = 1;
+            continue;
+        }
+        if (strcmp(a, "--trust") == 0) {
+            trust = 1;
             continue;
         }
         if (strcmp(a, "-q") == 0) {
@@ -259,7 +265,7 @@ int main(int argc, char **argv)
 
     {
         uint64_t off = 0;
-        oct_err err = oct_open(oct_path, 0, &file, &off);
+        oct_err err = oct_open(oct_path, trust ? OCT_OPEN_TRUST : 0u, &file, &off);
         if (err != OCT_OK) {
             if (err == OCT_EIO)
                 diag_path_error(oct_path, "%s", strerror(errno));

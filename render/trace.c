@@ -2,6 +2,11 @@
 #include "render/trace.h"
 
 #include <math.h>
+#include <string.h>
+
+#if defined(__SSE4_1__)
+#include <smmintrin.h>
+#endif
 
 #include "format/oct_normal.h"
 
@@ -10,9 +15,6 @@ uint32_t trace_max_steps(unsigned levels)
     return 3u * (UINT32_C(1) << levels) + levels;
 }
 
-/* The voxel k in [lo, hi] along `axis` that the ray occupies at local time t
- * (trace.h's tie rule), starting from the estimate k. T is monotone in k, so
- * at most a few moves; the bounds keep it inside the cell being left. */
 /* floor(x) clamped to [lo, hi] and converted without overflow. */
 static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
 {
@@ -24,39 +26,6 @@ static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
     return (uint32_t)f;
 }
 
-static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, uint32_t hi, double t);
-
-/* The same from the position p = o + t*d on that axis. Fast path: when p is
- * more than SETTLE_MARGIN voxel inside a voxel of [lo, hi], that voxel is
- * the answer: p and T() differ by far less (about 2^-31 voxel at level 20,
- * see RENDER.md), so no T() evaluation can disagree. Otherwise settle. */
-#define SETTLE_MARGIN 1e-6
-static inline uint32_t settle_at(const trace_ray *r, int axis, double p, uint32_t lo, uint32_t hi,
-                                 double t)
-{
-    double f = floor(p), frac = p - f;
-    if (f >= (double)lo && f <= (double)hi && frac > SETTLE_MARGIN && frac < 1.0 - SETTLE_MARGIN)
-        return (uint32_t)f;
-    return settle(r, axis, floor_clamp(p, lo, hi), lo, hi, t);
-}
-
-static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, uint32_t hi, double t)
-{
-    if (r->sgn[axis] > 0) {
-        while (k < hi && trace_plane_time(r, axis, (double)k + 1.0) <= t)
-            k++;
-        while (k > lo && trace_plane_time(r, axis, (double)k) > t)
-            k--;
-    } else {
-        while (k > lo && trace_plane_time(r, axis, (double)k) <= t)
-            k--;
-        while (k < hi && trace_plane_time(r, axis, (double)k + 1.0) > t)
-            k++;
-    }
-    return k;
-}
-
-
 int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r)
 {
     if (tree->levels < 1 || tree->levels > OCT_MAX_LEVELS)
@@ -66,6 +35,7 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     const double scale = n / tree->edge;
     double o[3], d[3];
     unsigned active = 0;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         if (!isfinite(eye[a]) || !isfinite(dir[a]))
             return 0;
@@ -93,6 +63,7 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
      * position only. */
     double t0 = -INFINITY, t1 = INFINITY;
     int entry = -1;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         if (!(active >> a & 1)) {
             if (o[a] < 0.0 || o[a] > n)
@@ -115,7 +86,8 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
      * coordinates of the grid's magnitude whatever the eye's distance. */
     if (t0 > 0.0) {
         r->t_base = t0;
-        for (int a = 0; a < 3; a++) {
+    #pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
             double p = o[a];
             if (a == entry)
                 p = r->sgn[a] > 0 ? 0.0 : n;
@@ -125,10 +97,12 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
         }
     } else {
         r->t_base = 0.0;
-        for (int a = 0; a < 3; a++)
+    #pragma GCC unroll 3
+    for (int a = 0; a < 3; a++)
             r->o[a] = o[a];
     }
     double t_end = INFINITY;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         r->ot[a] = (active >> a & 1) ? r->o[a] : -INFINITY;
         if (active >> a & 1) {
@@ -140,9 +114,9 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     if (!(t_end > 0.0))
         return 0;
     r->t_end = t_end;
+#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        r->v[a] = (active >> a & 1) ? settle_at(r, a, r->o[a], 0, nvox - 1, 0.0)
-                                    : floor_clamp(r->o[a], 0, nvox - 1);
+        r->v[a] = (active >> a & 1) ? 0u : floor_clamp(r->o[a], 0, nvox - 1);
     }
     return 1;
 }
@@ -170,6 +144,75 @@ static double plane_time(const oct_tree *tree, const trace_ray *r, uint64_t idx,
     return t;
 }
 
+#if defined(__SSE4_1__)
+/* The same traversal with the three axes in SSE registers: (x, y) in one,
+ * (z, w) in the other, w a dummy lane (o = inv = 0) whose exit time stays
+ * +inf: its mid-plane time is 0, never > tc, so it never picks a near half,
+ * and it never equals a step time te < t_end, so its mask bits are 0. The
+ * arithmetic per lane is the scalar T() above, operation for operation. */
+typedef struct trace_frame_v {
+    __m128d txy, tzw; /* exit times of the node's cell */
+    uint64_t prefix;
+    uint32_t mask, ci;
+} trace_frame_v;
+
+/* lane masks for a 3-bit axis set */
+static const int32_t trace_lut[8][4] __attribute__((aligned(16))) = {
+    {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
+    {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+};
+
+/* Step two below K: walks the empty cell (corner V, edge size > 1, entered
+ * at tc with exit times Txy, Tzw) voxel by voxel. Its entry voxel is found
+ * bit by bit as on entry into any cell; then a unit DDA whose exit times are
+ * T of the voxel's far faces runs until the cell's own exit time, where the
+ * caller leaves the cell as above K: the same voxels, times and step count as
+ * walking the cell as a subtree with an all-empty mask. Returns the step
+ * count (steps plus the voxel steps taken), max_steps + 1 when the bound is
+ * passed. Out of line: the default K = L never calls it. */
+static __attribute__((noinline)) uint32_t
+trace_walk_empty(__m128i V, uint32_t size, __m128d TC, __m128d Wxy, __m128d Wzw, __m128d ZOxy,
+                 __m128d ZOzw, __m128d ZIxy, __m128d ZIzw, double zoz, double ziz, unsigned far,
+                 uint32_t steps, uint32_t max_steps)
+{
+    const __m128d c2 = _mm_min_pd(Wxy, Wzw);
+    const double te_cell = _mm_cvtsd_f64(_mm_min_pd(c2, _mm_shuffle_pd(c2, c2, 1)));
+    while (size > 1) {
+        const uint32_t half = size >> 1;
+        const __m128i H = _mm_set1_epi32((int32_t)half);
+        const __m128i MID = _mm_add_epi32(V, H);
+        const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ZOxy), ZIxy);
+        const __m128d TMzw =
+            _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ZOzw), ZIzw);
+        const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw);
+        Wxy = _mm_blendv_pd(Wxy, TMxy, Nxy);
+        Wzw = _mm_blendv_pd(Wzw, TMzw, Nzw);
+        const unsigned b = ((unsigned)_mm_movemask_pd(Nxy) | (unsigned)_mm_movemask_pd(Nzw) << 2) ^ far;
+        V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[b])));
+        size = half;
+    }
+    /* far-face offsets and unit moves per lane; the dummy lane w uses
+     * o = -1/2, inv = +inf so that its exit time is +inf */
+    const __m128i FARV = _mm_setr_epi32((int32_t)(far & 1u), (int32_t)(far >> 1 & 1u),
+                                        (int32_t)(far >> 2 & 1u), 0);
+    const __m128i DIRV = _mm_sub_epi32(_mm_add_epi32(FARV, FARV), _mm_set1_epi32(1));
+    const __m128d WZOzw = _mm_setr_pd(zoz, -0.5), WZIzw = _mm_setr_pd(ziz, INFINITY);
+    for (;;) {
+        const __m128d w2 = _mm_min_pd(Wxy, Wzw);
+        const __m128d WEv = _mm_min_pd(w2, _mm_shuffle_pd(w2, w2, 1));
+        if (_mm_cvtsd_f64(WEv) >= te_cell)
+            return steps;
+        if (++steps > max_steps)
+            return steps;
+        const unsigned wm = (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Wxy, WEv)) |
+                            (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Wzw, WEv)) << 2;
+        V = _mm_add_epi32(V, _mm_and_si128(DIRV, _mm_load_si128((const __m128i *)trace_lut[wm])));
+        const __m128i F = _mm_add_epi32(V, FARV);
+        Wxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(F), ZOxy), ZIxy);
+        Wzw = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(F, F)), WZOzw), WZIzw);
+    }
+}
+
 int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
                        trace_hit *hit)
 {
@@ -180,63 +223,297 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     if (tree->node_count[0] == 0)
         return 0;
     const unsigned split = opts->split > levels ? levels : opts->split;
+    const int refine = opts->refine;
     const uint32_t max_steps = trace_max_steps(levels);
-    /* per axis: all ones when stepping up (the exit plane is the cell's top) */
-    const uint32_t up[3] = {r->sgn[0] > 0 ? ~0u : 0u, r->sgn[1] > 0 ? ~0u : 0u,
-                            r->sgn[2] > 0 ? ~0u : 0u};
-    uint64_t node[OCT_MAX_LEVELS]; /* node[d]: the depth-d ancestor of v */
-    unsigned valid = 0;            /* node[0..valid] hold for the current v */
-    node[0] = 0;
-    uint32_t v[3] = {r->v[0], r->v[1], r->v[2]};
-    double tc = 0.0; /* local time the ray entered v */
-    const double otx = r->ot[0], oty = r->ot[1], otz = r->ot[2];
-    const double ivx = r->inv[0], ivy = r->inv[1], ivz = r->inv[2];
     const double t_end = r->t_end;
+    const oct_group *const *groups = tree->groups;
+
+    double zo[4], zi[4], root[4];
+    unsigned far = 0;
+    const double nroot = (double)(UINT32_C(1) << levels);
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const int act = r->active >> a & 1;
+        zo[a] = act ? r->ot[a] : (double)r->v[a] + 0.5;
+        zi[a] = act ? r->inv[a] : INFINITY;
+        far |= (r->sgn[a] > 0 ? 1u : 0u) << a; /* sgn is +1 on a zero axis */
+        root[a] = ((far >> a & 1u ? nroot : 0.0) - zo[a]) * zi[a];
+    }
+    zo[3] = 0.0;
+    zi[3] = 0.0;
+    root[3] = INFINITY;
+    const __m128d ZOxy = _mm_loadu_pd(zo), ZOzw = _mm_loadu_pd(zo + 2);
+    const __m128d ZIxy = _mm_loadu_pd(zi), ZIzw = _mm_loadu_pd(zi + 2);
+
+    trace_frame_v fr[OCT_MAX_LEVELS];
+    __m128d TPxy = _mm_loadu_pd(root), TPzw = _mm_loadu_pd(root + 2);
+    uint32_t M = groups[0][0].mask[0];
+    uint64_t P = groups[0][0].base;
+    fr[0].txy = TPxy;
+    fr[0].tzw = TPzw;
+    fr[0].mask = M;
+    fr[0].prefix = P;
+    fr[0].ci = 0;
+    unsigned d = 0, ci = 0;
+    uint32_t size = UINT32_C(1) << levels;
+    __m128i V = _mm_setzero_si128();
+    __m128d Txy, Tzw, TC = _mm_setzero_pd();
+    double tc = 0.0;
     uint32_t steps = 0;
 
+    goto enter;
     for (;;) {
-        /* Vertical traverse (Figure 2) from the deepest still-valid ancestor
-         * down to the first empty child, or to the voxel. */
-        unsigned depth = valid;
-        uint32_t size;   /* edge, in voxels, of the cell to leave next */
-        int occupied = 0;
-        uint64_t vidx = 0;
-        for (;;) {
-            const unsigned bit = levels - 1 - depth;
-            const unsigned ci = ((v[0] >> bit) & 1u) | (((v[1] >> bit) & 1u) << 1) |
-                                (((v[2] >> bit) & 1u) << 2);
-            const oct_group *g = tree->groups[depth];
-            if (!((oct_node_mask(g, node[depth]) >> ci) & 1u)) {
-                /* Step one skips the whole empty cell while it is at depth
-                 * <= K; below K, step two walks single voxels. */
-                size = depth + 1 <= split ? UINT32_C(1) << bit : 1u;
-                break;
+        uint32_t Mn;
+        uint64_t Pn;
+        if (M >> ci & 1u) {
+            const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+            if (d == levels) {
+                /* a voxel */
+                if (!refine) {
+                    hit->hit = 1;
+                    hit->voxel = n;
+                    hit->t = r->t_base + tc;
+                    break;
+                }
+                const __m128d m2 = _mm_min_pd(Txy, Tzw);
+                const double te = _mm_cvtsd_f64(_mm_min_sd(m2, _mm_unpackhi_pd(m2, m2)));
+                uint32_t v[4];
+                _mm_storeu_si128((__m128i *)v, V);
+                double tp = plane_time(tree, r, n, v, tc, te < t_end ? te : t_end);
+                if (tp >= 0.0) {
+                    hit->hit = 1;
+                    hit->voxel = n;
+                    hit->t = r->t_base + tp;
+                    break;
+                }
+                goto step;
             }
-            uint64_t child = oct_child_index(g, node[depth], ci);
-            if (depth == levels - 1) {
-                occupied = 1;
-                vidx = child;
-                size = 1;
-                break;
-            }
-            node[++depth] = child;
+            const oct_group *gr = &groups[d][n >> 3];
+            const unsigned k = (unsigned)(n & 7u);
+            uint64_t masks;
+            memcpy(&masks, gr->mask, 8);
+            Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
+            Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+        } else if (d > split && d < levels) {
+            /* step two, below K: walk the empty cell voxel by voxel */
+            steps = trace_walk_empty(V, size, TC, Txy, Tzw, ZOxy, ZOzw, ZIxy, ZIzw, zo[2], zi[2], far,
+                                     steps, max_steps);
+            if (steps > max_steps)
+                goto out;
+            goto step;
+        } else {
+            goto step;
         }
-        valid = depth;
-        if (occupied && !opts->refine) {
-            hit->hit = 1;
-            hit->voxel = vidx;
-            hit->t = r->t_base + tc;
+        /* the cell becomes the parent: push it, then enter its child */
+        fr[d].txy = Txy;
+        fr[d].tzw = Tzw;
+        fr[d].mask = Mn;
+        fr[d].prefix = Pn;
+        fr[d].ci = ci;
+        M = Mn;
+        P = Pn;
+        TPxy = Txy;
+        TPzw = Tzw;
+    enter:;
+        {
+            const uint32_t half = size >> 1;
+            const __m128i H = _mm_set1_epi32((int32_t)half);
+            const __m128i MID = _mm_add_epi32(V, H);
+            const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ZOxy), ZIxy);
+            const __m128d TMzw =
+                _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ZOzw), ZIzw);
+            const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw); /* near */
+            Txy = _mm_blendv_pd(TPxy, TMxy, Nxy);
+            Tzw = _mm_blendv_pd(TPzw, TMzw, Nzw);
+            ci = ((unsigned)_mm_movemask_pd(Nxy) | (unsigned)_mm_movemask_pd(Nzw) << 2) ^ far;
+            V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[ci])));
+            size = half;
+            d++;
+            continue;
+        }
+    step:;
+        const __m128d m2 = _mm_min_pd(Txy, Tzw);
+        const __m128d TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)); /* te in both lanes */
+        const double te = _mm_cvtsd_f64(TEv);
+        if (te >= t_end || ++steps > max_steps)
             break;
+        __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
+        unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+        while (~(ci ^ far) & smask) {
+            d--;
+            if (d == 0)
+                goto out;
+            size <<= 1;
+            V = _mm_andnot_si128(_mm_set1_epi32((int32_t)(size - 1u)), V);
+            Txy = TPxy;
+            Tzw = TPzw;
+            ci = fr[d].ci;
+            const trace_frame_v *pf = &fr[d - 1];
+            M = pf->mask;
+            P = pf->prefix;
+            TPxy = pf->txy;
+            TPzw = pf->tzw;
+            /* One stepped axis a, on the far half: the parent's exit on a is
+             * the same plane (= te) and its other exits are later, so its
+             * stepped set is {a} again; only ties need comparing anew. */
+            if (smask & (smask - 1u)) {
+                Exy = _mm_cmpeq_pd(Txy, TEv);
+                Ezw = _mm_cmpeq_pd(Tzw, TEv);
+                smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+            }
         }
+        ci ^= smask;
+        Txy = _mm_blendv_pd(Txy, TPxy, Exy);
+        Tzw = _mm_blendv_pd(Tzw, TPzw, Ezw);
+        V = _mm_xor_si128(V, _mm_and_si128(_mm_set1_epi32((int32_t)size),
+                                           _mm_load_si128((const __m128i *)trace_lut[smask])));
+        TC = TEv;
+        tc = te;
+    }
+out:;
+    uint32_t v[4];
+    _mm_storeu_si128((__m128i *)v, V);
+    hit->xyz[0] = v[0];
+    hit->xyz[1] = v[1];
+    hit->xyz[2] = v[2];
+    hit->steps = steps;
+    return hit->hit;
+}
+#else
+/* One node of the descent stack: the node's child mask and first-child index,
+ * its cell's three exit-plane times, and its child index in its parent. */
+typedef struct trace_frame {
+    double tex[3];
+    uint64_t prefix; /* index in the next depth of the node's first child */
+    uint32_t mask;   /* child mask; 0 for an empty cell walked voxel by voxel */
+    uint32_t ci;     /* child index (x + 2y + 4z) of this node in its parent */
+} trace_frame;
 
-        /* Leave the cell: the nearest of its three exit planes, all from T(). */
-        const uint32_t cmask = ~(size - 1u);
-        const uint32_t lx = v[0] & cmask, ly = v[1] & cmask, lz = v[2] & cmask;
-        const uint32_t bx = lx + (size & up[0]), by = ly + (size & up[1]), bz = lz + (size & up[2]);
-        const double tx = (bx - otx) * ivx, ty = (by - oty) * ivy, tz = (bz - otz) * ivz;
-        double te = tx < ty ? tx : ty;
-        te = tz < te ? tz : te;
-        if (occupied) {
+/* Stack-based traversal. The state is the current cell (depth d, child ci of
+ * its parent node, integer corner v, edge `size`), the time tc the ray entered
+ * it and its three exit-plane times; the ancestors are on a stack. A step
+ * leaves the cell through the axes whose exit time is the minimum te: when
+ * every such axis is on the near half of the parent, the next cell is the
+ * sibling across (one mask test); otherwise the parent is left too (pop) and
+ * the test repeats one level up — the paper's common ancestor, found without
+ * re-descending. Entering a non-empty cell chooses, per axis, the half the ray
+ * is in at tc by comparing tc with the mid-plane time T(mid): that is the tie
+ * rule of trace.h read bit by bit (T is monotone in k), so entry voxels are
+ * never estimated from positions. Every time is T_a(k) = (k - o_a) * inv_a of
+ * an integer plane, as before. Zero axes use o' = v + 1/2, inv' = +inf, so
+ * that T(k) = -inf for k <= v and +inf above: the ray stays in voxel v. */
+int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       trace_hit *hit)
+{
+    const unsigned levels = tree->levels;
+    hit->hit = 0;
+    hit->t = INFINITY;
+    hit->steps = 0;
+    if (tree->node_count[0] == 0)
+        return 0;
+    const unsigned split = opts->split > levels ? levels : opts->split;
+    const int refine = opts->refine;
+    const uint32_t max_steps = trace_max_steps(levels);
+    const double t_end = r->t_end;
+    const oct_group *const *groups = tree->groups;
+
+    /* plane-time parameters per axis; far: the child bit of the far half */
+    double zo[3], zi[3];
+    unsigned far = 0;
+    for (int a = 0; a < 3; a++) {
+        if (r->active >> a & 1) {
+            zo[a] = r->ot[a];
+            zi[a] = r->inv[a];
+            far |= (r->sgn[a] > 0 ? 1u : 0u) << a;
+        } else {
+            zo[a] = (double)r->v[a] + 0.5;
+            zi[a] = INFINITY;
+            far |= 1u << a;
+        }
+    }
+    const double zox = zo[0], zoy = zo[1], zoz = zo[2];
+    const double zix = zi[0], ziy = zi[1], ziz = zi[2];
+    const unsigned fx = far & 1u, fy = far >> 1 & 1u, fz = far >> 2 & 1u;
+    const double nroot = (double)(UINT32_C(1) << levels);
+
+    trace_frame fr[OCT_MAX_LEVELS];
+    /* the current cell's parent node (fr[d - 1], kept in registers) */
+    double tpx = ((fx ? nroot : 0.0) - zox) * zix;
+    double tpy = ((fy ? nroot : 0.0) - zoy) * ziy;
+    double tpz = ((fz ? nroot : 0.0) - zoz) * ziz;
+    uint32_t M = groups[0][0].mask[0];
+    uint64_t P = groups[0][0].base;
+    fr[0].tex[0] = tpx;
+    fr[0].tex[1] = tpy;
+    fr[0].tex[2] = tpz;
+    fr[0].mask = M;
+    fr[0].prefix = P;
+    fr[0].ci = 0;
+    /* the current cell */
+    unsigned d = 0, ci = 0;
+    uint32_t vx = 0, vy = 0, vz = 0, size = UINT32_C(1) << levels;
+    double tx, ty, tz, tc = 0.0;
+    uint32_t steps = 0;
+
+    goto enter;
+    for (;;) {
+        const unsigned occ = M >> ci & 1u;
+        if (d < levels && (occ || d > split)) {
+            /* the cell becomes the parent: push it, then enter its child */
+            uint32_t Mn = 0;
+            uint64_t Pn = 0;
+            if (occ) {
+                const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+                const oct_group *gr = &groups[d][n >> 3];
+                const unsigned k = (unsigned)(n & 7u);
+                uint64_t masks;
+                memcpy(&masks, gr->mask, 8);
+                Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
+                Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+            }
+            fr[d].tex[0] = tx;
+            fr[d].tex[1] = ty;
+            fr[d].tex[2] = tz;
+            fr[d].mask = Mn;
+            fr[d].prefix = Pn;
+            fr[d].ci = ci;
+            M = Mn;
+            P = Pn;
+            tpx = tx;
+            tpy = ty;
+            tpz = tz;
+        enter:;
+            /* the child the ray is in at tc: per axis, the far half when the
+             * mid plane is crossed at or before tc */
+            const uint32_t half = size >> 1;
+            const double tmx = ((double)(vx + half) - zox) * zix;
+            const double tmy = ((double)(vy + half) - zoy) * ziy;
+            const double tmz = ((double)(vz + half) - zoz) * ziz;
+            const unsigned nx = tmx > tc, ny = tmy > tc, nz = tmz > tc; /* near halves */
+            tx = nx ? tmx : tpx;
+            ty = ny ? tmy : tpy;
+            tz = nz ? tmz : tpz;
+            const unsigned bx = nx ^ fx, by = ny ^ fy, bz = nz ^ fz;
+            vx |= (0u - bx) & half;
+            vy |= (0u - by) & half;
+            vz |= (0u - bz) & half;
+            ci = bx | by << 1 | bz << 2;
+            size = half;
+            d++;
+            continue;
+        }
+        if (occ) {
+            /* a voxel */
+            const uint64_t vidx = P + oct_popcount64(M & ((1u << ci) - 1u));
+            if (!refine) {
+                hit->hit = 1;
+                hit->voxel = vidx;
+                hit->t = r->t_base + tc;
+                break;
+            }
+            double te = tx < ty ? tx : ty;
+            te = tz < te ? tz : te;
+            const uint32_t v[3] = {vx, vy, vz};
             double tp = plane_time(tree, r, vidx, v, tc, te < t_end ? te : t_end);
             if (tp >= 0.0) {
                 hit->hit = 1;
@@ -245,42 +522,53 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
                 break;
             }
         }
+
+        /* leave the cell through its nearest exit planes */
+        double te = tx < ty ? tx : ty;
+        te = tz < te ? tz : te;
         if (te >= t_end || ++steps > max_steps)
             break;
-        uint32_t nx, ny, nz;
-        if (size == 1u) {
-            /* step two: unit steps, only the axes whose plane comes first */
-            nx = tx == te ? (up[0] ? bx : bx - 1u) : v[0];
-            ny = ty == te ? (up[1] ? by : by - 1u) : v[1];
-            nz = tz == te ? (up[2] ? bz : bz - 1u) : v[2];
-        } else {
-            const uint32_t hi = size - 1u;
-            nx = tx == te ? (up[0] ? bx : bx - 1u)
-                 : (r->active & 1u) ? settle_at(r, 0, r->o[0] + te * r->d[0], lx, lx + hi, te)
-                                    : v[0];
-            ny = ty == te ? (up[1] ? by : by - 1u)
-                 : (r->active & 2u) ? settle_at(r, 1, r->o[1] + te * r->d[1], ly, ly + hi, te)
-                                    : v[1];
-            nz = tz == te ? (up[2] ? bz : bz - 1u)
-                 : (r->active & 4u) ? settle_at(r, 2, r->o[2] + te * r->d[2], lz, lz + hi, te)
-                                    : v[2];
+        unsigned smask = (unsigned)(tx == te) | (unsigned)(ty == te) << 1 |
+                         (unsigned)(tz == te) << 2;
+        /* an axis stepped on the far half leaves the parent: go up */
+        while (~(ci ^ far) & smask) {
+            d--;
+            if (d == 0)
+                goto out; /* the root is left (te >= t_end caught it first) */
+            size <<= 1;
+            vx &= ~(size - 1u);
+            vy &= ~(size - 1u);
+            vz &= ~(size - 1u);
+            tx = tpx;
+            ty = tpy;
+            tz = tpz;
+            ci = fr[d].ci;
+            const trace_frame *pf = &fr[d - 1];
+            M = pf->mask;
+            P = pf->prefix;
+            tpx = pf->tex[0];
+            tpy = pf->tex[1];
+            tpz = pf->tex[2];
+            smask = (unsigned)(tx == te) | (unsigned)(ty == te) << 1 | (unsigned)(tz == te) << 2;
         }
-        /* Figure 3's XOR: the highest changed bit names the common ancestor. */
-        const uint32_t diff = (v[0] ^ nx) | (v[1] ^ ny) | (v[2] ^ nz);
-        const unsigned keep = levels - 1u - (31u - (unsigned)__builtin_clz(diff | 1u));
-        if (keep < valid)
-            valid = keep;
-        v[0] = nx;
-        v[1] = ny;
-        v[2] = nz;
+        /* the sibling across the stepped axes: their exits are the parent's */
+        ci ^= smask;
+        tx = smask & 1u ? tpx : tx;
+        ty = smask & 2u ? tpy : ty;
+        tz = smask & 4u ? tpz : tz;
+        vx ^= (0u - (smask & 1u)) & size;
+        vy ^= (0u - (smask >> 1 & 1u)) & size;
+        vz ^= (0u - (smask >> 2 & 1u)) & size;
         tc = te;
     }
-    hit->xyz[0] = v[0];
-    hit->xyz[1] = v[1];
-    hit->xyz[2] = v[2];
+out:
+    hit->xyz[0] = vx;
+    hit->xyz[1] = vy;
+    hit->xyz[2] = vz;
     hit->steps = steps;
     return hit->hit;
 }
+#endif
 
 int trace_ray_cast(const oct_tree *tree, const trace_opts *opts, const double eye[3],
                    const double dir[3], trace_hit *hit)

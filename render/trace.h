@@ -1,7 +1,7 @@
 /* trace: the two-step discrete ray traversal of an oct_tree (Stolte & Caubet,
  * sections 3-4): clip to the root cube, skip empty cells down to the split
  * depth K, then walk voxel by voxel, looking occupancy up from the common
- * ancestor found by the XOR of old and new voxel coordinates.
+ * ancestor, kept on a stack (see RENDER.md, "Traversal").
  *
  * Coordinates. The ray is mapped to grid coordinates, where the root cube is
  * [0, N]^3 with N = 2^L voxels a side: g = (p - origin) * N / edge. The
@@ -59,7 +59,9 @@ typedef struct trace_ray {
     double t_base;    /* t of the local start point on the caller's ray */
     double t_end;     /* local t at which the ray leaves the root cube */
     int32_t sgn[3];   /* +1 or -1; +1 on a zero axis */
-    uint32_t v[3];    /* voxel occupied at local t = 0 */
+    uint32_t v[3];    /* zero axis: the voxel the ray stays in (floor(o) clamped to
+                         N - 1); 0 on other axes, whose start voxel the
+                         traversal finds from T() */
     unsigned active;  /* bit a set when axis a has a non-zero direction */
 } trace_ray;
 

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/image.h"
 #include "format/oct_normal.h"
 #include "render/frame.h"
 #include "tests/tree_util.h"
@@ -118,11 +119,45 @@ static void test_degenerate_cameras_no_nan(void **state)
     tree_util_free(t);
 }
 
+static float bits_float(uint32_t b)
+{
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+/* The renderer's table sRGB encoder is image_srgb8 bit for bit: every float
+ * within 256 ulps of each code change, a stride through [0, 1], specials.
+ * (An exhaustive run over all 2^30 floats in [0, 1] was done once.) */
+static void test_srgb_table_exact(void **state)
+{
+    (void)state;
+    uint32_t changes = 0;
+    uint8_t prev = image_srgb8(0.0f);
+    for (uint32_t b = 0; b <= 0x3f800000u; b += 61) {
+        float x = bits_float(b);
+        uint8_t want = image_srgb8(x);
+        assert_int_equal(frame_srgb8(x), want);
+        if (want != prev) {
+            changes++;
+            for (uint32_t c = b > 61 + 256 ? b - 61 - 256 : 0; c <= b + 256; c++)
+                assert_int_equal(frame_srgb8(bits_float(c)), image_srgb8(bits_float(c)));
+        }
+        prev = want;
+    }
+    assert_int_equal(changes, 255);
+    static const float special[] = {-0.0f, -1.0f, 1.0f, 1.0000001f, 2.0f, 1e30f, INFINITY,
+                                    -INFINITY, NAN, 1e-45f, 0.0031308f};
+    for (size_t k = 0; k < sizeof special / sizeof special[0]; k++)
+        assert_int_equal(frame_srgb8(special[k]), image_srgb8(special[k]));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_degenerate_cameras_no_nan),
+        cmocka_unit_test(test_srgb_table_exact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
