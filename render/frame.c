@@ -81,6 +81,8 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
         j1 = cam->height;
     const uint32_t i0 = tx * FRAME_TILE;
     double us[FRAME_TILE];
+    trace_eye eye;
+    trace_eye_init(job->tree, cam->eye, &eye); /* eye.ok = 0: every ray misses */
     for (uint32_t i = i0; i < i1; i++)
         us[i - i0] = camera_u(cam, i);
     for (uint32_t j = ty * FRAME_TILE; j < j1; j++) {
@@ -89,7 +91,14 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
             double dir[3];
             camera_ray_uv(cam, us[i - i0], v, dir);
             trace_hit h;
-            trace_ray_cast(job->tree, &job->opts, cam->eye, dir, &h);
+            trace_ray r;
+            if (trace_setup_eye(&eye, dir, &r)) {
+                trace_ray_prepared(job->tree, &job->opts, &r, &h);
+            } else { /* trace_ray_cast's miss */
+                h.hit = 0;
+                h.t = INFINITY;
+                h.steps = 0;
+            }
             float rgb[3], n[3];
             shade_hit(job->tree, &job->shade, &h, dir, rgb, n);
             size_t px = (size_t)j * w + i;

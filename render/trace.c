@@ -26,34 +26,49 @@ static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
     return (uint32_t)f;
 }
 
-int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r)
+int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e)
 {
+    e->ok = 0;
     if (tree->levels < 1 || tree->levels > OCT_MAX_LEVELS)
         return 0;
-    const uint32_t nvox = UINT32_C(1) << tree->levels;
-    const double n = (double)nvox;
-    const double scale = n / tree->edge;
-    double o[3], d[3];
+    e->nvox = UINT32_C(1) << tree->levels;
+    e->n = (double)e->nvox;
+    e->scale = e->n / tree->edge;
+    for (int a = 0; a < 3; a++) {
+        if (!isfinite(eye[a]))
+            return 0;
+        e->o[a] = (eye[a] - tree->origin[a]) * e->scale;
+        if (!isfinite(e->o[a]))
+            return 0;
+        e->lo[a] = 0.0 - e->o[a];
+        e->hi[a] = e->n - e->o[a];
+        e->inside[a] = !(e->o[a] < 0.0 || e->o[a] > e->n);
+    }
+    e->ok = 1;
+    return 1;
+}
+
+int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
+{
+    if (!e->ok)
+        return 0;
+    const double n = e->n, scale = e->scale;
+    const double *o = e->o;
+    double d[3];
     unsigned active = 0;
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        if (!isfinite(eye[a]) || !isfinite(dir[a]))
+        if (!isfinite(dir[a]))
             return 0;
-        o[a] = (eye[a] - tree->origin[a]) * scale;
         d[a] = dir[a] * scale;
-        if (!isfinite(o[a]) || !isfinite(d[a]))
+        if (!isfinite(d[a]))
             return 0;
-        double inv = 1.0 / d[a];
-        if (d[a] != 0.0 && isfinite(inv)) {
-            active |= 1u << a;
-            r->inv[a] = inv;
-            r->sgn[a] = d[a] > 0 ? 1 : -1;
-            r->d[a] = d[a];
-        } else {
-            r->inv[a] = 1.0;
-            r->sgn[a] = 1;
-            r->d[a] = 0.0;
-        }
+        const double inv = 1.0 / d[a];
+        const int act = d[a] != 0.0 && isfinite(inv);
+        active |= (unsigned)act << a;
+        r->inv[a] = act ? inv : 1.0;
+        r->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
+        r->d[a] = act ? d[a] : 0.0;
     }
     if (!active)
         return 0;
@@ -66,11 +81,11 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
         if (!(active >> a & 1)) {
-            if (o[a] < 0.0 || o[a] > n)
+            if (!e->inside[a])
                 return 0;
             continue;
         }
-        double ta = (0.0 - o[a]) * r->inv[a], tb = (n - o[a]) * r->inv[a];
+        double ta = e->lo[a] * r->inv[a], tb = e->hi[a] * r->inv[a];
         double lo = ta < tb ? ta : tb, hi = ta < tb ? tb : ta;
         if (lo > t0) {
             t0 = lo;
@@ -86,8 +101,8 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
      * coordinates of the grid's magnitude whatever the eye's distance. */
     if (t0 > 0.0) {
         r->t_base = t0;
-    #pragma GCC unroll 3
-    for (int a = 0; a < 3; a++) {
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++) {
             double p = o[a];
             if (a == entry)
                 p = r->sgn[a] > 0 ? 0.0 : n;
@@ -97,8 +112,8 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
         }
     } else {
         r->t_base = 0.0;
-    #pragma GCC unroll 3
-    for (int a = 0; a < 3; a++)
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++)
             r->o[a] = o[a];
     }
     double t_end = INFINITY;
@@ -116,9 +131,17 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     r->t_end = t_end;
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        r->v[a] = (active >> a & 1) ? 0u : floor_clamp(r->o[a], 0, nvox - 1);
+        r->v[a] = (active >> a & 1) ? 0u : floor_clamp(r->o[a], 0, e->nvox - 1);
     }
     return 1;
+}
+
+int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r)
+{
+    trace_eye e;
+    if (!trace_eye_init(tree, eye, &e))
+        return 0;
+    return trace_setup_eye(&e, dir, r);
 }
 
 /* --refine: local t where the ray meets voxel `idx`'s stored plane, if that

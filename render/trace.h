@@ -78,6 +78,23 @@ static inline double trace_plane_time(const trace_ray *r, int axis, double k)
  * non-finite eye. `dir` need not be unit length; t is in its units. */
 int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r);
 
+/* trace_setup in two parts for many rays from one eye: the eye's grid
+ * position and its slab differences once (trace_eye_init, 0 when no ray from
+ * this eye can be set up), then per ray the rest (trace_setup_eye). The same
+ * operations on the same values as trace_setup, which is the pair. */
+typedef struct trace_eye {
+    double o[3];      /* eye in grid units */
+    double lo[3];     /* 0 - o */
+    double hi[3];     /* n - o */
+    double n, scale;  /* N = 2^L, N / edge */
+    uint32_t nvox;
+    int inside[3];    /* 0 <= o_a <= N */
+    int ok;
+} trace_eye;
+
+int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e);
+int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r);
+
 typedef struct trace_opts {
     unsigned split;   /* K: empty cells of depth <= K are skipped whole; 0..L */
     int refine;       /* intersect the voxel's stored plane, fall through on miss */
