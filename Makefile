@@ -117,9 +117,10 @@ $(B)/bin/rasterize: $(B)/rasterize/main.o $(LIBS)
 $(B)/bin/render: $(B)/render/main.o $(LIBS)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIBS) $(LDLIBS)
-$(B)/bin/%: $(B)/bench/%_main.o $(LIBS)
+# Benchmarks may build synthetic trees with the test utilities (tests/tree_util).
+$(B)/bin/%: $(B)/bench/%_main.o $(LIB_TEST) $(LIBS)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIBS) $(LDLIBS)
+	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIB_TEST) $(LIBS) $(LDLIBS)
 
 $(B)/tests/%: $(B)/tests/%.o $(LIB_TEST) $(LIBS)
 	@mkdir -p $(dir $@)

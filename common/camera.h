@@ -1,0 +1,36 @@
+/* camera: the pinhole camera of INTERFACE.md, pixel centre -> unit ray. */
+#ifndef CAMERA_H
+#define CAMERA_H
+
+#include <stdint.h>
+
+#define CAMERA_MAX_SIZE 32768 /* pixels a side */
+
+typedef struct camera {
+    double eye[3];
+    double forward[3], right[3], up[3]; /* orthonormal: right x up' = -forward */
+    double h;                           /* tan(fov * pi / 360) */
+    uint32_t width, height;
+} camera;
+
+typedef enum camera_err {
+    CAMERA_OK = 0,
+    CAMERA_ENONFINITE, /* a NaN or infinite coordinate or fov */
+    CAMERA_ESAME,      /* eye == target */
+    CAMERA_EPARALLEL,  /* up parallel to the view direction (or zero) */
+    CAMERA_EFOV,       /* fov not in (0, 180) degrees */
+    CAMERA_ESIZE,      /* width or height not in 1..CAMERA_MAX_SIZE */
+} camera_err;
+
+const char *camera_strerror(camera_err e); /* static text, never NULL */
+
+/* Sets up c for the view (world coordinates, fov in degrees, size in
+ * pixels). Returns CAMERA_OK or why the view is rejected (c then undefined). */
+camera_err camera_init(camera *c, const double eye[3], const double target[3], const double up[3],
+                       double fov_deg, long width, long height);
+
+/* Unit direction through the centre of pixel (i, j), i left to right, j top
+ * to bottom, exactly as INTERFACE.md writes it. */
+void camera_ray(const camera *c, uint32_t i, uint32_t j, double dir[3]);
+
+#endif

@@ -1,0 +1,156 @@
+/* image: atomic PNG and PFM writers. */
+#include "common/image.h"
+
+#include <errno.h>
+#include <math.h>
+#include <png.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "common/atomic_file.h"
+
+int image_rgb_size(uint32_t w, uint32_t h, size_t *out)
+{
+    if (w == 0 || h == 0 || (size_t)w > SIZE_MAX / 3 / (size_t)h)
+        return -1;
+    *out = (size_t)w * h * 3;
+    return 0;
+}
+
+uint8_t image_srgb8(float linear)
+{
+    double x = linear;
+    if (!(x > 0.0))
+        return 0;
+    if (x >= 1.0)
+        return 255;
+    double s = x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+    return (uint8_t)(s * 255.0 + 0.5);
+}
+
+static void png_fail(png_structp png, png_const_charp msg)
+{
+    (void)msg;
+    png_longjmp(png, 1);
+}
+
+static void png_warn(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg;
+}
+
+static void png_write_cb(png_structp png, png_bytep data, size_t n)
+{
+    atomic_file *af = png_get_io_ptr(png);
+    if (atomic_file_write(af, data, n) != 0)
+        png_longjmp(png, 2);
+}
+
+static void png_flush_cb(png_structp png)
+{
+    (void)png;
+}
+
+int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h,
+                    const char **failed_op)
+{
+    const char *op = "open";
+    size_t bytes;
+    if (image_rgb_size(w, h, &bytes) != 0 || w > PNG_UINT_31_MAX || h > PNG_UINT_31_MAX) {
+        errno = EOVERFLOW;
+        if (failed_op)
+            *failed_op = "size";
+        return -1;
+    }
+    atomic_file *af = atomic_file_open(path);
+    if (!af) {
+        if (failed_op)
+            *failed_op = op;
+        return -1;
+    }
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, png_fail, png_warn);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    volatile int err = 0;
+    if (!png || !info) {
+        errno = ENOMEM;
+        op = "png";
+        goto fail;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        /* 2: our write callback failed and set errno; 1: libpng's own error */
+        err = errno ? errno : EIO;
+        op = "write";
+        goto fail;
+    }
+    errno = 0;
+    png_set_write_fn(png, af, png_write_cb, png_flush_cb);
+    png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (uint32_t j = 0; j < h; j++)
+        png_write_row(png, rgb + (size_t)j * w * 3);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    if (atomic_file_commit(af, failed_op) != 0)
+        return -1;
+    return 0;
+fail:
+    png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
+    atomic_file_abort(af);
+    if (err)
+        errno = err;
+    if (failed_op)
+        *failed_op = op;
+    return -1;
+}
+
+int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t h,
+                    const char **failed_op)
+{
+    if (w == 0 || h == 0 || (size_t)w > SIZE_MAX / 4 / (size_t)h) {
+        errno = EOVERFLOW;
+        if (failed_op)
+            *failed_op = "size";
+        return -1;
+    }
+    atomic_file *af = atomic_file_open(path);
+    if (!af) {
+        if (failed_op)
+            *failed_op = "open";
+        return -1;
+    }
+    char head[64];
+    int hn = snprintf(head, sizeof head, "Pf\n%u %u\n-1.0\n", (unsigned)w, (unsigned)h);
+    if (atomic_file_write(af, head, (size_t)hn) != 0)
+        goto fail;
+    uint8_t row[4096];
+    for (uint32_t jj = h; jj-- > 0;) { /* bottom row first */
+        const float *src = values + (size_t)jj * w;
+        size_t fill = 0;
+        for (uint32_t i = 0; i < w; i++) {
+            uint32_t u;
+            memcpy(&u, &src[i], 4);
+            row[fill++] = (uint8_t)u;
+            row[fill++] = (uint8_t)(u >> 8);
+            row[fill++] = (uint8_t)(u >> 16);
+            row[fill++] = (uint8_t)(u >> 24);
+            if (fill == sizeof row) {
+                if (atomic_file_write(af, row, fill) != 0)
+                    goto fail;
+                fill = 0;
+            }
+        }
+        if (fill && atomic_file_write(af, row, fill) != 0)
+            goto fail;
+    }
+    return atomic_file_commit(af, failed_op);
+fail:;
+    int e = errno;
+    atomic_file_abort(af);
+    errno = e;
+    if (failed_op)
+        *failed_op = "write";
+    return -1;
+}

@@ -1,0 +1,40 @@
+/* frame: renders one view of a tree into caller-owned buffers on N threads;
+ * tiles are handed out through an atomic counter, every pixel is computed
+ * the same way whatever thread takes it, so output is byte-identical for
+ * any thread count. */
+#ifndef FRAME_H
+#define FRAME_H
+
+#include <stdint.h>
+
+#include "common/camera.h"
+#include "format/oct.h"
+#include "render/shade.h"
+#include "render/trace.h"
+
+#define FRAME_TILE 32 /* pixels a tile side */
+
+typedef struct frame_job {
+    const oct_tree *tree;
+    const camera *cam;
+    trace_opts opts;
+    shade_params shade;
+    uint8_t *rgb;       /* width*height*3 sRGB bytes, rows top to bottom; required */
+    float *depth;       /* width*height t values (+inf on miss), or NULL */
+    uint8_t *normals;   /* width*height*3 bytes, (n + 1) / 2 per channel, or NULL */
+    unsigned threads;   /* >= 1 */
+    /* Called by the calling thread after each tile it finishes, with tiles
+     * done so far and the total; may be NULL. */
+    void (*progress)(void *ctx, uint64_t done, uint64_t total);
+    void *progress_ctx;
+} frame_job;
+
+typedef struct frame_stats {
+    uint64_t rays, hits, steps; /* steps: DDA steps, all rays */
+} frame_stats;
+
+/* Returns 0, or an errno value when a thread could not be started (the
+ * frame is then rendered by the threads that did start). */
+int frame_render(const frame_job *job, frame_stats *stats);
+
+#endif

@@ -1,0 +1,54 @@
+/* shade: two-sided Lambert + ambient. */
+#include "render/shade.h"
+
+#include <math.h>
+
+#include "format/oct_normal.h"
+
+void shade_default_light(const camera *cam, double light[3])
+{
+    double l[3];
+    for (int a = 0; a < 3; a++)
+        l[a] = -cam->forward[a] + 0.7 * cam->up[a] - 0.5 * cam->right[a];
+    double n = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+    for (int a = 0; a < 3; a++)
+        light[a] = l[a] / n;
+}
+
+int shade_set_light(shade_params *p, const double light[3])
+{
+    double n = sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
+    if (!(n > 0.0) || !isfinite(n))
+        return -1;
+    for (int a = 0; a < 3; a++)
+        p->light[a] = light[a] / n;
+    return 0;
+}
+
+void shade_hit(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
+               const double dir[3], float rgb[3], float n[3])
+{
+    if (!hit->hit) {
+        for (int a = 0; a < 3; a++) {
+            rgb[a] = p->background[a];
+            n[a] = 0.0f;
+        }
+        return;
+    }
+    uint32_t rec = tree->voxels[hit->voxel];
+    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
+    double facing = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+    if (facing > 0.0) /* two-sided: face the viewer */
+        for (int a = 0; a < 3; a++)
+            n[a] = -n[a];
+    double lam = n[0] * p->light[0] + n[1] * p->light[1] + n[2] * p->light[2];
+    if (lam < 0.0)
+        lam = 0.0;
+    unsigned s = tree->surfaces ? tree->surfaces[hit->voxel] : 0;
+    if (s >= tree->surface_count)
+        s = 0;
+    const float *col = tree->palette + 3 * s;
+    float k = p->ambient + (1.0f - p->ambient) * (float)lam;
+    for (int a = 0; a < 3; a++)
+        rgb[a] = col[a] * k;
+}

@@ -1,0 +1,104 @@
+/* trace: the two-step discrete ray traversal of an oct_tree (Stolte & Caubet,
+ * sections 3-4): clip to the root cube, skip empty cells down to the split
+ * depth K, then walk voxel by voxel, looking occupancy up from the common
+ * ancestor found by the XOR of old and new voxel coordinates.
+ *
+ * Coordinates. The ray is mapped to grid coordinates, where the root cube is
+ * [0, N]^3 with N = 2^L voxels a side: g = (p - origin) * N / edge. The
+ * direction is scaled by the same factor, so the ray parameter t is the same
+ * in both spaces: world units along the caller's direction (unit direction ->
+ * world distance).
+ *
+ * Integer positions, exact times. The traversal state is the integer voxel
+ * (x, y, z) (a 0-fraction-bit fixed-point position, 32 bits a coordinate,
+ * exact at every level up to OCT_MAX_LEVELS = 20). Continuous time is never
+ * accumulated: the time at which the ray crosses the grid plane "axis a = k"
+ * is always evaluated from scratch as
+ *       T_a(k) = (k - o_a) * inv_a        (double, one rounding each op)
+ * where o is the ray's grid-space start point and inv_a = 1 / d_a. The
+ * coarse step and the fine step use this one function, so the hand-over
+ * from coarse cells to voxels can neither skip a voxel nor enter one twice:
+ * both steps agree on every plane-crossing order by construction. The error
+ * of T relative to the exact real crossing is <= 2 ulp of T (one subtraction,
+ * exact when k and o share an exponent range, and one multiplication; the
+ * reciprocal adds 0.5 ulp), independent of the number of steps. It is exact
+ * (T equals the real crossing) whenever o has at most 52 - L fraction bits
+ * and 1/d_a is representable, e.g. axis-aligned and (±1,±1,±1)-type rays
+ * from dyadic points; ties between axes in such cases are therefore exact.
+ *
+ * Tie rule (which voxel a ray is in at time t). Along each axis with d_a > 0
+ * the ray occupies voxel k for T_a(k) <= t < T_a(k+1); with d_a < 0 for
+ * T_a(k+1) <= t < T_a(k). A voxel is occupied for the intersection of its
+ * three half-open intervals, so at every t the ray is in exactly one voxel.
+ * Consequences: a ray crossing a face enters the voxel beyond it; a ray
+ * through an edge or corner goes straight to the diagonal voxel and does not
+ * enter the voxels it only touches (zero-length interval). A direction
+ * component of exactly +0 or -0 (or so small that 1/d overflows) is treated
+ * as 0: the ray stays in voxel floor(o_a), and a ray lying in the root's
+ * upper face o_a = N belongs to voxel N - 1 (the root cube is closed).
+ *
+ * Start. A ray starting outside the cube is re-based to its entry point
+ * (entry-axis coordinate set exactly on the face, the others clamped into
+ * [0, N]); t of a hit is then t_base + local t. A ray starting inside a
+ * voxel that is occupied hits it at t = 0.
+ */
+#ifndef TRACE_H
+#define TRACE_H
+
+#include <stdint.h>
+
+#include "format/oct.h"
+
+/* A ray prepared for one tree (grid space, re-based). Plain data: the tests'
+ * brute-force oracle reads it. */
+typedef struct trace_ray {
+    double o[3];      /* local start point in grid units, inside [0, N]^3 */
+    double ot[3];     /* o for T(); -inf on a zero axis so that T = +inf */
+    double inv[3];    /* 1/d per axis; 1 on a zero axis */
+    double d[3];      /* direction in grid units per t; 0 on a zero axis */
+    double t_base;    /* t of the local start point on the caller's ray */
+    double t_end;     /* local t at which the ray leaves the root cube */
+    int32_t sgn[3];   /* +1 or -1; +1 on a zero axis */
+    uint32_t v[3];    /* voxel occupied at local t = 0 */
+    unsigned active;  /* bit a set when axis a has a non-zero direction */
+} trace_ray;
+
+/* Time (local, in t units) at which the ray crosses grid plane axis = k;
+ * +inf on a zero axis. The one crossing function the traversal uses. */
+static inline double trace_plane_time(const trace_ray *r, int axis, double k)
+{
+    return (k - r->ot[axis]) * r->inv[axis];
+}
+
+/* Maps eye + t * dir into `tree`'s grid and clips it to the root cube (one
+ * slab test). Returns 1 when some t >= 0 lies inside the cube (r filled),
+ * 0 when the ray misses it, has a zero or non-finite direction, or a
+ * non-finite eye. `dir` need not be unit length; t is in its units. */
+int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r);
+
+typedef struct trace_opts {
+    unsigned split;   /* K: empty cells of depth <= K are skipped whole; 0..L */
+    int refine;       /* intersect the voxel's stored plane, fall through on miss */
+} trace_opts;
+
+typedef struct trace_hit {
+    int hit;          /* 1 hit, 0 miss */
+    uint64_t voxel;   /* index into tree->voxels / surfaces */
+    uint32_t xyz[3];  /* integer voxel coordinates */
+    double t;         /* caller's t of the hit: voxel entry, or plane with refine */
+    uint32_t steps;   /* DDA steps taken (<= trace_max_steps) */
+} trace_hit;
+
+/* Upper bound on steps for a tree of `levels` levels: 3 * 2^L + L. */
+uint32_t trace_max_steps(unsigned levels);
+
+/* Traces one ray. Thread-safe (reads the tree only), no allocation.
+ * Returns hit->hit. On a miss hit->t is +inf. */
+int trace_ray_cast(const oct_tree *tree, const trace_opts *opts, const double eye[3],
+                   const double dir[3], trace_hit *hit);
+
+/* The same on a prepared ray (r from trace_setup returning 1). */
+int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       trace_hit *hit);
+
+#endif

@@ -1,0 +1,220 @@
+/* views: per-view options, views files, orbits. */
+#include "render/views.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/camera.h"
+#include "common/parse_num.h"
+
+void views_defaults(views_view *v)
+{
+    memset(v, 0, sizeof *v);
+    v->up[2] = 1.0;
+    v->fov = 30.0;
+    v->width = 512;
+    v->height = 512;
+}
+
+static const char *const value_opts[] = {"-o", "--eye", "--target", "--up", "--fov",
+                                         "--size", "--depth", "--normals"};
+
+int views_is_option(const char *name)
+{
+    for (size_t i = 0; i < sizeof value_opts / sizeof value_opts[0]; i++)
+        if (strcmp(name, value_opts[i]) == 0)
+            return 1;
+    return 0;
+}
+
+int views_apply(views_view *v, const char *name, const char *value, char *msg, size_t n)
+{
+    parse_err e = PARSE_OK;
+    if (strcmp(name, "-o") == 0) {
+        v->out = value;
+    } else if (strcmp(name, "--depth") == 0) {
+        v->depth = value;
+    } else if (strcmp(name, "--normals") == 0) {
+        v->normals = value;
+    } else if (strcmp(name, "--eye") == 0) {
+        e = parse_vec3(value, v->eye);
+        v->has_eye = 1;
+    } else if (strcmp(name, "--target") == 0) {
+        e = parse_vec3(value, v->target);
+        v->has_target = 1;
+    } else if (strcmp(name, "--up") == 0) {
+        e = parse_vec3(value, v->up);
+    } else if (strcmp(name, "--fov") == 0) {
+        e = parse_double(value, &v->fov);
+        if (e == PARSE_OK && !(v->fov > 0.0 && v->fov < 180.0)) {
+            snprintf(msg, n, "--fov: %s: must be in (0, 180) degrees", value);
+            return -1;
+        }
+    } else if (strcmp(name, "--size") == 0) {
+        e = parse_size(value, CAMERA_MAX_SIZE, &v->width, &v->height);
+    } else {
+        snprintf(msg, n, "unknown option '%s'", name);
+        return -1;
+    }
+    if (e == PARSE_OK && (strcmp(name, "-o") == 0 || strcmp(name, "--depth") == 0 ||
+                          strcmp(name, "--normals") == 0) && value[0] == '\0') {
+        snprintf(msg, n, "%s: empty path", name);
+        return -1;
+    }
+    if (e != PARSE_OK) {
+        snprintf(msg, n, "%s: '%s': %s%s", name, value, parse_strerror(e),
+                 strcmp(name, "--size") == 0 ? " (WxH, 1..32768 each)" : "");
+        return -1;
+    }
+    return 0;
+}
+
+int views_parse(char *text, const views_view *base, views_view **out, size_t *count,
+                views_report_fn report, void *ctx)
+{
+    views_view *arr = NULL;
+    size_t n = 0, cap = 0;
+    int bad = 0;
+    unsigned lineno = 0;
+    char *line = text;
+    *out = NULL;
+    *count = 0;
+    while (line && *line) {
+        char *nl = strchr(line, '\n');
+        if (nl)
+            *nl = '\0';
+        lineno++;
+        char *hash = strchr(line, '#');
+        if (hash)
+            *hash = '\0';
+        views_view v = *base;
+        v.line = lineno;
+        char msg[256];
+        int line_bad = 0, any = 0;
+        char *save = NULL;
+        for (char *tok = strtok_r(line, " \t\r\v\f", &save); tok;
+             tok = strtok_r(NULL, " \t\r\v\f", &save)) {
+            any = 1;
+            if (!views_is_option(tok)) {
+                snprintf(msg, sizeof msg, "unknown option '%s'", tok);
+                line_bad = 1;
+                break;
+            }
+            char *val = strtok_r(NULL, " \t\r\v\f", &save);
+            if (!val) {
+                snprintf(msg, sizeof msg, "option '%s' needs a value", tok);
+                line_bad = 1;
+                break;
+            }
+            if (views_apply(&v, tok, val, msg, sizeof msg) != 0) {
+                line_bad = 1;
+                break;
+            }
+        }
+        if (any && !line_bad && !v.out) {
+            snprintf(msg, sizeof msg, "a view needs -o OUT.png");
+            line_bad = 1;
+        }
+        if (line_bad) {
+            bad = 1;
+            if (report)
+                report(ctx, lineno, msg);
+        } else if (any && !bad) {
+            if (n == cap) {
+                size_t nc = cap ? 2 * cap : 8;
+                views_view *na = realloc(arr, nc * sizeof *na);
+                if (!na) {
+                    free(arr);
+                    return -2;
+                }
+                arr = na;
+                cap = nc;
+            }
+            arr[n++] = v;
+        }
+        line = nl ? nl + 1 : NULL;
+    }
+    if (bad) {
+        free(arr);
+        return -1;
+    }
+    *out = arr;
+    *count = n;
+    return 0;
+}
+
+int views_check_pattern(const char *p)
+{
+    int conv = 0;
+    for (; *p; p++) {
+        if (*p != '%')
+            continue;
+        p++;
+        if (*p == '%')
+            continue;
+        while (*p && strchr("0-+ ", *p))
+            p++;
+        while (*p >= '0' && *p <= '9')
+            p++;
+        if (*p != 'd' && *p != 'i' && *p != 'u')
+            return -1;
+        conv++;
+    }
+    return conv == 1 ? 0 : -1;
+}
+
+/* The pattern is checked by views_check_pattern: one integer conversion. */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+views_view *views_orbit(const views_view *base, unsigned n, const char *pattern)
+{
+    if (n == 0 || views_check_pattern(pattern) != 0)
+        return NULL;
+    double un = sqrt(base->up[0] * base->up[0] + base->up[1] * base->up[1] +
+                     base->up[2] * base->up[2]);
+    if (!(un > 0.0))
+        return NULL;
+    double ax[3], rel[3], h = 0.0;
+    for (int a = 0; a < 3; a++) {
+        ax[a] = base->up[a] / un;
+        rel[a] = base->eye[a] - base->target[a];
+        h += rel[a] * ax[a];
+    }
+    double e1[3], r = 0.0;
+    for (int a = 0; a < 3; a++) {
+        e1[a] = rel[a] - h * ax[a];
+        r += e1[a] * e1[a];
+    }
+    r = sqrt(r);
+    if (!(r > 0.0))
+        return NULL;
+    for (int a = 0; a < 3; a++)
+        e1[a] /= r;
+    double e2[3] = {ax[1] * e1[2] - ax[2] * e1[1], ax[2] * e1[0] - ax[0] * e1[2],
+                    ax[0] * e1[1] - ax[1] * e1[0]};
+    int len = snprintf(NULL, 0, pattern, (int)n) + 16;
+    if (len <= 16)
+        return NULL;
+    views_view *arr = malloc(n * (sizeof *arr + (size_t)len));
+    if (!arr)
+        return NULL;
+    char *names = (char *)(arr + n);
+    for (unsigned k = 0; k < n; k++) {
+        double ang = 2.0 * M_PI * (double)k / (double)n;
+        double c = cos(ang), s = sin(ang);
+        arr[k] = *base;
+        for (int a = 0; a < 3; a++)
+            arr[k].eye[a] = base->target[a] + h * ax[a] + r * (c * e1[a] + s * e2[a]);
+        arr[k].has_eye = 1;
+        char *name = names + (size_t)k * (size_t)len;
+        snprintf(name, (size_t)len, pattern, (int)k);
+        arr[k].out = name;
+        arr[k].depth = NULL;
+        arr[k].normals = NULL;
+    }
+    return arr;
+}
+#pragma GCC diagnostic pop

@@ -1,0 +1,340 @@
+/* Tests for render/trace: the two-step traversal against a brute-force oracle
+ * that slab-tests every voxel, for every split K, on random sparse trees and
+ * deep single-path trees; degenerate rays; the step bound. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <fenv.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "render/trace.h"
+#include "tests/tree_util.h"
+
+/* xorshift64*: deterministic, seedable */
+static uint64_t rng_state = 0x9e3779b97f4a7c15u;
+static uint64_t rng(void)
+{
+    rng_state ^= rng_state >> 12;
+    rng_state ^= rng_state << 25;
+    rng_state ^= rng_state >> 27;
+    return rng_state * 0x2545f4914f6cdd1dULL;
+}
+static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
+static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
+
+/* The oracle: first voxel of the list whose occupancy interval (trace.h's
+ * tie rule, times from trace_plane_time) is non-empty and starts at or after
+ * local 0. Returns the list index or -1. */
+static long oracle(const trace_ray *r, unsigned levels, const uint32_t (*vox)[3], size_t n,
+                   double *t_out)
+{
+    const uint32_t lim = UINT32_C(1) << levels;
+    long best = -1;
+    double best_t = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        double lo = 0.0, hi = INFINITY;
+        int ok = 1;
+        for (int a = 0; a < 3 && ok; a++) {
+            double k = (double)vox[i][a];
+            if (!(r->active >> a & 1)) {
+                double f = floor(r->o[a]);
+                uint32_t kz = f >= (double)lim ? lim - 1 : (uint32_t)f;
+                ok = vox[i][a] == kz;
+                continue;
+            }
+            double en = trace_plane_time(r, a, r->sgn[a] > 0 ? k : k + 1);
+            double ex = trace_plane_time(r, a, r->sgn[a] > 0 ? k + 1 : k);
+            if (en > lo)
+                lo = en;
+            if (ex < hi)
+                hi = ex;
+        }
+        if (ok && lo < hi && lo < best_t) {
+            best_t = lo;
+            best = (long)i;
+        }
+    }
+    *t_out = best_t;
+    return best;
+}
+
+/* A grid-space coordinate of one of the kinds the plan asks for. */
+static double pick_coord(uint32_t lim)
+{
+    switch (irand(6)) {
+    case 0: return (double)irand(lim + 1);                       /* on a grid plane */
+    case 1: return irand(2) ? 0.0 : (double)lim;                   /* on the root face */
+    case 2: return -2.0 * lim + 5.0 * lim * urand();               /* anywhere, often out */
+    case 3: return (double)irand(lim) + (double)irand(8) / 8.0;    /* dyadic inside */
+    default: return (double)lim * urand();                         /* inside */
+    }
+}
+
+static double pick_dir(void)
+{
+    switch (irand(10)) {
+    case 0: return 0.0;
+    case 1: return -0.0;
+    case 2: return irand(2) ? 1e-30 : -1e-30;
+    case 3: return irand(2) ? 1.0 : -1.0;
+    case 4: return irand(2) ? 0.5 : -2.0;
+    default: return 2.0 * urand() - 1.0;
+    }
+}
+
+typedef struct check_stats {
+    unsigned long rays, hits, traces;
+} check_stats;
+
+/* Casts eye+t*dir for every split and compares with the oracle. */
+static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, const double eye[3],
+                      const double dir[3], unsigned k_min, check_stats *st)
+{
+    trace_ray r;
+    int in = trace_setup(tree, eye, dir, &r);
+    double ot = INFINITY;
+    long want = in ? oracle(&r, tree->levels, vox, n, &ot) : -1;
+    st->rays++;
+    if (want >= 0)
+        st->hits++;
+    for (unsigned k = k_min; k <= tree->levels; k++) {
+        for (int refine = 0; refine < 1; refine++) {
+            trace_opts opts = {k, refine};
+            trace_hit h;
+            trace_ray_cast(tree, &opts, eye, dir, &h);
+            st->traces++;
+            assert_true(h.steps <= trace_max_steps(tree->levels));
+            if (want < 0) {
+                if (h.hit)
+                    print_error("L=%u K=%u eye %.17g %.17g %.17g dir %a %a %a: hit %u %u %u, oracle miss\n",
+                                tree->levels, k, eye[0], eye[1], eye[2], dir[0], dir[1], dir[2],
+                                h.xyz[0], h.xyz[1], h.xyz[2]);
+                assert_false(h.hit);
+                assert_true(isinf(h.t));
+                continue;
+            }
+            if (!h.hit || memcmp(h.xyz, vox[want], sizeof h.xyz) != 0)
+                print_error("L=%u K=%u eye %.17g %.17g %.17g dir %a %a %a: got %d %u %u %u want %u %u %u\n",
+                            tree->levels, k, eye[0], eye[1], eye[2], dir[0], dir[1], dir[2], h.hit,
+                            h.xyz[0], h.xyz[1], h.xyz[2], vox[want][0], vox[want][1], vox[want][2]);
+            assert_true(h.hit);
+            assert_memory_equal(h.xyz, vox[want], sizeof h.xyz);
+            /* attrs carry the list index + 1: the voxel index is right too */
+            assert_int_equal(tree->voxels[h.voxel], (uint32_t)want + 1);
+            double t = r.t_base + ot;
+            assert_true(fabs(h.t - t) <= 1e-9 * fabs(t) || h.t == t);
+        }
+    }
+}
+
+/* Random sparse tree with unique voxels; attrs = index + 1. */
+static oct_tree *random_tree(unsigned levels, double density, const double origin[3], double edge,
+                             uint32_t (**vox_out)[3], size_t *n_out)
+{
+    const uint32_t lim = UINT32_C(1) << levels;
+    size_t cells = (size_t)lim * lim * lim;
+    size_t want = (size_t)(density * (double)cells);
+    if (want > 3000)
+        want = 3000;
+    uint8_t *seen = calloc(cells, 1);
+    uint32_t (*vox)[3] = calloc(want + 1, sizeof *vox);
+    uint32_t *attrs = calloc(want + 1, sizeof *attrs);
+    assert_non_null(seen);
+    assert_non_null(vox);
+    assert_non_null(attrs);
+    size_t n = 0;
+    for (size_t tries = 0; n < want && tries < 20 * want; tries++) {
+        uint32_t x = irand(lim), y = irand(lim), z = irand(lim);
+        size_t c = ((size_t)z * lim + y) * lim + x;
+        if (seen[c])
+            continue;
+        seen[c] = 1;
+        vox[n][0] = x;
+        vox[n][1] = y;
+        vox[n][2] = z;
+        attrs[n] = (uint32_t)n + 1;
+        n++;
+    }
+    oct_tree *t = tree_util_build(levels, origin, edge, (const uint32_t(*)[3])vox, n, attrs, NULL,
+                                  1, NULL);
+    assert_non_null(t);
+    assert_int_equal(t->voxel_count, n);
+    free(seen);
+    free(attrs);
+    *vox_out = vox;
+    *n_out = n;
+    return t;
+}
+
+static void test_random_trees_vs_oracle(void **state)
+{
+    (void)state;
+    feenableexcept(FE_INVALID);
+    static const double densities[] = {0.0, 0.002, 0.02, 0.1, 0.4, 1.0};
+    check_stats st = {0, 0, 0};
+    for (unsigned levels = 1; levels <= 6; levels++) {
+        for (unsigned ti = 0; ti < 18; ti++) {
+            const double origin[3] = {ti % 2 ? -1.5 : 0.0, ti % 3 ? 2.0 : 0.0, 0.25};
+            const double edge = ti % 4 ? 2.0 : 1.0;
+            uint32_t(*vox)[3];
+            size_t n;
+            oct_tree *t = random_tree(levels, densities[ti % 6], origin, edge, &vox, &n);
+            const uint32_t lim = UINT32_C(1) << levels;
+            for (unsigned ri = 0; ri < 1000; ri++) {
+                double g[3], dir[3], eye[3];
+                do {
+                    for (int a = 0; a < 3; a++)
+                        dir[a] = pick_dir();
+                } while (dir[0] == 0 && dir[1] == 0 && dir[2] == 0);
+                for (int a = 0; a < 3; a++) {
+                    g[a] = pick_coord(lim);
+                    eye[a] = origin[a] + g[a] * edge / (double)lim;
+                }
+                /* a third of the rays aim exactly at a voxel corner/edge/centre */
+                if (ri % 3 == 0) {
+                    double tgt[3];
+                    for (int a = 0; a < 3; a++) {
+                        tgt[a] = (double)irand(lim + 1) + (irand(2) ? 0.5 : 0.0);
+                        dir[a] = tgt[a] - g[a];
+                    }
+                    if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0)
+                        dir[2] = 1.0;
+                }
+                check_ray(t, (const uint32_t(*)[3])vox, n, eye, dir, 0, &st);
+            }
+            tree_util_free(t);
+            free(vox);
+        }
+    }
+    fedisableexcept(FE_INVALID);
+    print_message("trace: %lu rays, %lu hits, %lu traversals compared\n", st.rays, st.hits,
+                  st.traces);
+    assert_true(st.hits > st.rays / 10);
+}
+
+/* Levels 16-20: a few voxels around one random point, rays from far away
+ * aimed at its centre, faces, edges and corners. */
+static void test_deep_single_path(void **state)
+{
+    (void)state;
+    feenableexcept(FE_INVALID);
+    check_stats st = {0, 0, 0};
+    for (unsigned levels = 16; levels <= 20; levels++) {
+        const uint32_t lim = UINT32_C(1) << levels;
+        for (unsigned ti = 0; ti < 6; ti++) {
+            uint32_t c[3] = {1 + irand(lim - 2), 1 + irand(lim - 2), 1 + irand(lim - 2)};
+            uint32_t vox[27][3], attrs[27];
+            size_t n = 0;
+            for (int dz = -1; dz <= 1; dz++)
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++)
+                        if ((dx == 0 && dy == 0 && dz == 0) || irand(3) == 0) {
+                            vox[n][0] = (uint32_t)((int)c[0] + dx);
+                            vox[n][1] = (uint32_t)((int)c[1] + dy);
+                            vox[n][2] = (uint32_t)((int)c[2] + dz);
+                            attrs[n] = (uint32_t)n + 1;
+                            n++;
+                        }
+            const double origin[3] = {0, 0, 0};
+            oct_tree *t = tree_util_build(levels, origin, 1.0, (const uint32_t(*)[3])vox, n,
+                                          attrs, NULL, 1, NULL);
+            assert_non_null(t);
+            for (unsigned ri = 0; ri < 400; ri++) {
+                double tg[3], eye[3], dir[3];
+                for (int a = 0; a < 3; a++) {
+                    tg[a] = (double)c[a] + (double)irand(5) * 0.5 - 0.5; /* centre/face/edge/corner */
+                    double e;
+                    switch (irand(3)) {
+                    case 0: e = tg[a]; break;                               /* axis-aligned */
+                    case 1: e = -1e6 * lim + 3e6 * lim * urand(); break;   /* far */
+                    default: e = (double)lim * urand(); break;
+                    }
+                    eye[a] = e / (double)lim;
+                    dir[a] = (tg[a] - e) / (double)lim;
+                }
+                if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0)
+                    dir[0] = 1.0;
+                /* voxel-by-voxel walks at 2^20 cost 3 M steps a ray: all
+                 * splits on a few rays, the coarse-heavy ones on the rest */
+                check_ray(t, (const uint32_t(*)[3])vox, n, eye, dir, ri % 100 ? levels - 5 : 0, &st);
+            }
+            tree_util_free(t);
+        }
+    }
+    fedisableexcept(FE_INVALID);
+    print_message("trace deep: %lu rays, %lu hits\n", st.rays, st.hits);
+    assert_true(st.hits > st.rays / 2);
+}
+
+static void test_empty_tree_and_degenerate_rays(void **state)
+{
+    (void)state;
+    oct_tree *t = tree_util_simple(4, NULL, 0);
+    assert_non_null(t);
+    trace_opts o = {2, 0};
+    trace_hit h;
+    const double eye[3] = {0.5, 0.5, -1}, dir[3] = {0, 0, 1};
+    assert_int_equal(trace_ray_cast(t, &o, eye, dir, &h), 0);
+    assert_int_equal(h.steps, 0);
+    tree_util_free(t);
+
+    static const uint32_t one[1][3] = {{0, 0, 0}};
+    t = tree_util_simple(1, one, 1);
+    const double zero[3] = {0, 0, 0}, nan3[3] = {NAN, 0, 1}, inf3[3] = {INFINITY, 0, 0};
+    assert_int_equal(trace_ray_cast(t, &o, eye, zero, &h), 0);
+    assert_int_equal(trace_ray_cast(t, &o, eye, nan3, &h), 0);
+    assert_int_equal(trace_ray_cast(t, &o, inf3, dir, &h), 0);
+    /* eye inside the occupied voxel: t = 0 */
+    const double in[3] = {0.25, 0.25, 0.25};
+    assert_int_equal(trace_ray_cast(t, &o, in, dir, &h), 1);
+    assert_true(h.t == 0.0);
+    /* along the face x = 0.5 between voxel 0 and voxel 1 (x+): voxel x = 1, empty */
+    const double face[3] = {0.5, 0.25, -1};
+    assert_int_equal(trace_ray_cast(t, &o, face, dir, &h), 0);
+    /* along the root's lower face x = 0: voxel x = 0, hit at t = 1 */
+    const double lowface[3] = {0.0, 0.25, -1};
+    assert_int_equal(trace_ray_cast(t, &o, lowface, dir, &h), 1);
+    assert_true(h.t == 1.0);
+    /* eye at 1e30: no NaN, finite t or miss */
+    const double far[3] = {1e30, 1e30, 1e30}, back[3] = {-1, -1, -1};
+    feenableexcept(FE_INVALID);
+    trace_ray_cast(t, &o, far, back, &h);
+    fedisableexcept(FE_INVALID);
+    assert_true(!h.hit || isfinite(h.t));
+    tree_util_free(t);
+}
+
+static void test_tree_util_layout(void **state)
+{
+    (void)state;
+    /* two voxels in opposite corners of a level-2 grid, given out of order
+     * and duplicated */
+    static const uint32_t v[3][3] = {{3, 3, 3}, {0, 0, 0}, {3, 3, 3}};
+    oct_tree *t = tree_util_simple(2, v, 3);
+    assert_non_null(t);
+    assert_int_equal(t->voxel_count, 2);
+    assert_int_equal(t->node_count[0], 1);
+    assert_int_equal(t->node_count[1], 2);
+    assert_int_equal(oct_node_mask(t->groups[0], 0), 0x81);
+    assert_int_equal(oct_node_mask(t->groups[1], 0), 0x01);
+    assert_int_equal(oct_node_mask(t->groups[1], 1), 0x80);
+    assert_int_equal(oct_child_index(t->groups[0], 0, 7), 1);
+    assert_int_equal(oct_child_index(t->groups[1], 1, 7), 1);
+    tree_util_free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_tree_util_layout),
+        cmocka_unit_test(test_empty_tree_and_degenerate_rays),
+        cmocka_unit_test(test_random_trees_vs_oracle),
+        cmocka_unit_test(test_deep_single_path),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
