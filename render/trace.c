@@ -13,6 +13,33 @@ uint32_t trace_max_steps(unsigned levels)
 /* The voxel k in [lo, hi] along `axis` that the ray occupies at local time t
  * (trace.h's tie rule), starting from the estimate k. T is monotone in k, so
  * at most a few moves; the bounds keep it inside the cell being left. */
+/* floor(x) clamped to [lo, hi] and converted without overflow. */
+static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
+{
+    double f = floor(x);
+    if (!(f >= (double)lo))
+        return lo;
+    if (f >= (double)hi)
+        return hi;
+    return (uint32_t)f;
+}
+
+static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, uint32_t hi, double t);
+
+/* The same from the position p = o + t*d on that axis. Fast path: when p is
+ * more than SETTLE_MARGIN voxel inside a voxel of [lo, hi], that voxel is
+ * the answer: p and T() differ by far less (about 2^-31 voxel at level 20,
+ * see RENDER.md), so no T() evaluation can disagree. Otherwise settle. */
+#define SETTLE_MARGIN 1e-6
+static inline uint32_t settle_at(const trace_ray *r, int axis, double p, uint32_t lo, uint32_t hi,
+                                 double t)
+{
+    double f = floor(p), frac = p - f;
+    if (f >= (double)lo && f <= (double)hi && frac > SETTLE_MARGIN && frac < 1.0 - SETTLE_MARGIN)
+        return (uint32_t)f;
+    return settle(r, axis, floor_clamp(p, lo, hi), lo, hi, t);
+}
+
 static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, uint32_t hi, double t)
 {
     if (r->sgn[axis] > 0) {
@@ -29,16 +56,6 @@ static uint32_t settle(const trace_ray *r, int axis, uint32_t k, uint32_t lo, ui
     return k;
 }
 
-/* floor(x) clamped to [lo, hi] and converted without overflow. */
-static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
-{
-    double f = floor(x);
-    if (!(f >= (double)lo))
-        return lo;
-    if (f >= (double)hi)
-        return hi;
-    return (uint32_t)f;
-}
 
 int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r)
 {
@@ -124,10 +141,8 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
         return 0;
     r->t_end = t_end;
     for (int a = 0; a < 3; a++) {
-        uint32_t k = floor_clamp(r->o[a], 0, nvox - 1);
-        if (active >> a & 1)
-            k = settle(r, a, k, 0, nvox - 1, 0.0);
-        r->v[a] = k;
+        r->v[a] = (active >> a & 1) ? settle_at(r, a, r->o[a], 0, nvox - 1, 0.0)
+                                    : floor_clamp(r->o[a], 0, nvox - 1);
     }
     return 1;
 }
@@ -241,13 +256,13 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
         } else {
             const uint32_t hi = size - 1u;
             nx = tx == te ? (up[0] ? bx : bx - 1u)
-                 : (r->active & 1u) ? settle(r, 0, floor_clamp(r->o[0] + te * r->d[0], lx, lx + hi), lx, lx + hi, te)
+                 : (r->active & 1u) ? settle_at(r, 0, r->o[0] + te * r->d[0], lx, lx + hi, te)
                                     : v[0];
             ny = ty == te ? (up[1] ? by : by - 1u)
-                 : (r->active & 2u) ? settle(r, 1, floor_clamp(r->o[1] + te * r->d[1], ly, ly + hi), ly, ly + hi, te)
+                 : (r->active & 2u) ? settle_at(r, 1, r->o[1] + te * r->d[1], ly, ly + hi, te)
                                     : v[1];
             nz = tz == te ? (up[2] ? bz : bz - 1u)
-                 : (r->active & 4u) ? settle(r, 2, floor_clamp(r->o[2] + te * r->d[2], lz, lz + hi), lz, lz + hi, te)
+                 : (r->active & 4u) ? settle_at(r, 2, r->o[2] + te * r->d[2], lz, lz + hi, te)
                                     : v[2];
         }
         /* Figure 3's XOR: the highest changed bit names the common ancestor. */
