@@ -106,10 +106,11 @@ fail:
     return -1;
 }
 
-int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t h,
-                    const char **failed_op)
+/* PFM with `ch` channels (1: "Pf", 3: "PF"), bottom row first. */
+static int write_pfm(const char *path, const float *values, uint32_t w, uint32_t h, unsigned ch,
+                     const char **failed_op)
 {
-    if (w == 0 || h == 0 || (size_t)w > SIZE_MAX / 4 / (size_t)h) {
+    if (w == 0 || h == 0 || (size_t)w > SIZE_MAX / 4 / ch / (size_t)h) {
         errno = EOVERFLOW;
         if (failed_op)
             *failed_op = "size";
@@ -122,14 +123,16 @@ int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t 
         return -1;
     }
     char head[64];
-    int hn = snprintf(head, sizeof head, "Pf\n%u %u\n-1.0\n", (unsigned)w, (unsigned)h);
+    int hn = snprintf(head, sizeof head, "%s\n%u %u\n-1.0\n", ch == 3 ? "PF" : "Pf", (unsigned)w,
+                      (unsigned)h);
     if (atomic_file_write(af, head, (size_t)hn) != 0)
         goto fail;
     uint8_t row[4096];
+    const size_t n = (size_t)w * ch;
     for (uint32_t jj = h; jj-- > 0;) { /* bottom row first */
-        const float *src = values + (size_t)jj * w;
+        const float *src = values + (size_t)jj * n;
         size_t fill = 0;
-        for (uint32_t i = 0; i < w; i++) {
+        for (size_t i = 0; i < n; i++) {
             uint32_t u;
             memcpy(&u, &src[i], 4);
             row[fill++] = (uint8_t)u;
@@ -153,4 +156,16 @@ fail:;
     if (failed_op)
         *failed_op = "write";
     return -1;
+}
+
+int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t h,
+                    const char **failed_op)
+{
+    return write_pfm(path, values, w, h, 1, failed_op);
+}
+
+int image_write_pfm_rgb(const char *path, const float *values, uint32_t w, uint32_t h,
+                        const char **failed_op)
+{
+    return write_pfm(path, values, w, h, 3, failed_op);
 }

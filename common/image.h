@@ -26,4 +26,10 @@ int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h
 int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t h,
                     const char **failed_op);
 
+/* Writes a 3-channel PFM ("PF", scale -1.0, bottom row first); `values` is
+ * w*h*3 floats, rows top to bottom, channels interleaved (used for float
+ * normal images). Same return convention. */
+int image_write_pfm_rgb(const char *path, const float *values, uint32_t w, uint32_t h,
+                        const char **failed_op);
+
 #endif

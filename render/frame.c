@@ -110,6 +110,9 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
                 for (int a = 0; a < 3; a++)
                     job->normals[3 * px + (size_t)a] =
                         h.hit ? (uint8_t)((n[a] * 0.5f + 0.5f) * 255.0f + 0.5f) : 0;
+            if (job->normals_f)
+                for (int a = 0; a < 3; a++)
+                    job->normals_f[3 * px + (size_t)a] = h.hit ? n[a] : 0.0f;
             *hits += (uint64_t)h.hit;
             *steps += h.steps;
         }

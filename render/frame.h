@@ -22,6 +22,7 @@ typedef struct frame_job {
     uint8_t *rgb;       /* width*height*3 sRGB bytes, rows top to bottom; required */
     float *depth;       /* width*height t values (+inf on miss), or NULL */
     uint8_t *normals;   /* width*height*3 bytes, (n + 1) / 2 per channel, or NULL */
+    float *normals_f;   /* width*height*3 floats, the unit normal (0 on miss), or NULL */
     unsigned threads;   /* >= 1 */
     /* Called by the calling thread after each tile it finishes, with tiles
      * done so far and the total; may be NULL. */

@@ -39,7 +39,8 @@ static const char help_text[] =
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
     "  --fov DEG           vertical field of view, in (0, 180) (default 30)\n"
     "  --depth OUT.pfm     distance along each pixel's unit ray (PFM, +inf on miss)\n"
-    "  --normals OUT.png   surface normals as colour, (n + 1) / 2 per channel\n"
+    "  --normals OUT.png   surface normals as colour, (n + 1) / 2 per channel;\n"
+    "                      a name ending in .pfm gets float normals (3-channel PFM)\n"
     "  --split K           octree depth where the empty-space skipping stops (default: levels)\n"
     "  --refine            intersect the voxels' stored planes for sub-voxel depth\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
@@ -115,6 +116,13 @@ static char *read_text(const char *path)
     return buf;
 }
 
+/* True when path ends in ".pfm": --normals then writes float normals. */
+static int is_pfm(const char *path)
+{
+    size_t n = strlen(path);
+    return n >= 4 && strcmp(path + n - 4, ".pfm") == 0;
+}
+
 /* A view that frames the root cube: aim at its centre from the direction of
  * the benchmark view, far enough that its bounding sphere fits the fov. */
 static void frame_cube(const oct_tree *t, views_view *v)
@@ -152,7 +160,7 @@ int main(int argc, char **argv)
     views_view *list = NULL;
     size_t nviews = 0;
     uint8_t *rgb = NULL, *nrm = NULL;
-    float *depth = NULL;
+    float *depth = NULL, *nrm_f = NULL;
     camera *cams = NULL;
     oct_file *file = NULL;
     const oct_tree *tree = NULL;
@@ -344,16 +352,19 @@ int main(int argc, char **argv)
     if (status != EXIT_OK)
         goto done;
     rgb = malloc(max_px * 3);
-    int want_depth = 0, want_nrm = 0;
+    int want_depth = 0, want_nrm = 0, want_nrm_f = 0;
     for (size_t k = 0; k < nviews; k++) {
         want_depth |= list[k].depth != NULL;
-        want_nrm |= list[k].normals != NULL;
+        want_nrm |= list[k].normals != NULL && !is_pfm(list[k].normals);
+        want_nrm_f |= list[k].normals != NULL && is_pfm(list[k].normals);
     }
     if (want_depth)
         depth = malloc(max_px * sizeof *depth);
     if (want_nrm)
         nrm = malloc(max_px * 3);
-    if (!rgb || (want_depth && !depth) || (want_nrm && !nrm)) {
+    if (want_nrm_f)
+        nrm_f = malloc(max_px * 3 * sizeof *nrm_f);
+    if (!rgb || (want_depth && !depth) || (want_nrm && !nrm) || (want_nrm_f && !nrm_f)) {
         diag_error("out of memory for a %zu-pixel image", max_px);
         status = EXIT_RUNTIME;
         goto done;
@@ -382,7 +393,8 @@ int main(int argc, char **argv)
             shade_default_light(&cams[k], job.shade.light);
         job.rgb = rgb;
         job.depth = v->depth ? depth : NULL;
-        job.normals = v->normals ? nrm : NULL;
+        job.normals = v->normals && !is_pfm(v->normals) ? nrm : NULL;
+        job.normals_f = v->normals && is_pfm(v->normals) ? nrm_f : NULL;
         job.threads = (unsigned)threads;
         if (!quiet && diag_stderr_is_tty())
             job.progress = progress_bar;
@@ -404,7 +416,8 @@ int main(int argc, char **argv)
             status = EXIT_RUNTIME;
             goto done;
         }
-        if (v->normals && image_write_png(v->normals, nrm, w, h, &op) != 0) {
+        if (v->normals && (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, nrm_f, w, h, &op)
+                                              : image_write_png(v->normals, nrm, w, h, &op)) != 0) {
             diag_path_error(v->normals, "%s: %s", op ? op : "write", strerror(errno));
             status = EXIT_RUNTIME;
             goto done;
@@ -424,6 +437,7 @@ done:
     free(rgb);
     free(depth);
     free(nrm);
+    free(nrm_f);
     free(cams);
     free(list);
     free(views_text);
