@@ -26,7 +26,7 @@ FILENAME ~ /refcast.csv$/ && FNR > 1 && $7 == "std" { ref[$6] = $9; size = $8 }
 FILENAME ~ /render.csv$/ && FNR > 1 && $8 == "std" { k = $6 SUBSEP $7 SUBSEP $10
     ms[k] = $11; mr[k] = $12; me[k] = $13; p9[k] = $14; hm[k] = $16; nm[k] = $17; np[k] = $18; sz = $9 }
 END {
-    printf "| scene | levels | rasterize s | voxels | MB | bytes/voxel | peak RSS MiB | render ms (Mrays/s) | --refine ms | depth err mean / p99 | --refine mean / p99 | hit/miss % (--refine) | normal err mean / p99 ° | refcast s |\n"
+    print "| scene | levels | rasterize s | voxels | MB | bytes/voxel | peak RSS MiB | render ms (Mrays/s) | --refine ms | depth err mean / p99 | --refine mean / p99 | hit/miss % (--refine) | normal err mean / p99 ° | refcast s |"
     print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     for (i = 0; i < n; i++) {
         s = order[i]; best = -1
