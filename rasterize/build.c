@@ -33,6 +33,11 @@
 #define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
 #define MEAN_VALUE_LEVELS 3   /* the finest levels whose cells the mean-value form tests */
 _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradient enclosure");
+/* Cells of depth below this (larger than 1/256 of the cube) are too big for
+ * a gradient enclosure to be tight: there the plain interval test runs too,
+ * and either may drop the cell. From levels 10 up the mean-value levels are
+ * all this deep, so the cost is paid on coarse grids only. */
+#define MEAN_VALUE_ALONE_DEPTH 8
 #define NEWTON_STEPS 4        /* guarded Newton steps from the voxel centre onto f = 0 */
 #define NEWTON_TOL 0.25       /* stop once a step is below this fraction of a voxel: the
                                  linearisation error there, curvature x step^2 / 2, is far
@@ -477,10 +482,11 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                     break; /* outside the bounds */
                 have_box = 1;
             }
-            if (!ok[k] ? !cell_may_cross(wk, t, s, depth + 1, box, centre)
-                       : depth + 1 == c->levels &&
-                             centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3],
-                                                        box, centre)) {
+            if (!ok[k] || depth + 1 < MEAN_VALUE_ALONE_DEPTH
+                    ? !cell_may_cross(wk, t, s, depth + 1, box, centre)
+                    : depth + 1 == c->levels &&
+                          centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3],
+                                                     box, centre)) {
                 wk->st.taylor_drops += ok[k];
                 continue;
             }
