@@ -144,27 +144,43 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     return trace_setup_eye(&e, dir, r);
 }
 
-/* --refine: local t where the ray meets voxel `idx`'s stored plane, if that
- * lies in [t_in, t_out]; -1 otherwise. The plane: n . (p - centre) = offset,
- * in voxel units (grid space). */
-static double plane_time(const oct_tree *tree, const trace_ray *r, uint64_t idx,
-                         const uint32_t v[3], double t_in, double t_out)
+/* --refine in one occupied voxel `idx` (corner v), which the ray occupies
+ * for local t in [t_in, t_out]. The stored plane n . (p - centre) = offset
+ * (voxel units) splits space into s > 0 and s < 0, s(t) = n . (p(t) -
+ * centre) - offset; its normal is the field's gradient, so the side is
+ * consistent from voxel to voxel. *side is the side the ray was on when it
+ * entered the current run of consecutive occupied voxels (0: no run yet; the
+ * caller resets it in every empty cell). The ray hits this voxel when it is
+ * already across (s(t_in) on the other side, or 0: it crossed on the shared
+ * face or between two neighbours' slightly different planes: t_in), or
+ * crosses inside (s(t_out) across or 0: the plane time clamped to the
+ * voxel). Otherwise it goes on with *side kept. Returns 1 and sets *t_hit on
+ * a hit. */
+static int refine_voxel(const oct_tree *tree, const trace_ray *r, uint64_t idx,
+                        const uint32_t v[3], double t_in, double t_out, int *side, double *t_hit)
 {
-    uint32_t rec = tree->voxels[idx];
+    const uint32_t rec = tree->voxels[idx];
     float nf[3];
     oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, nf);
-    double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
-    double num = off, den = 0.0;
+    double num = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT)), den = 0.0;
     for (int a = 0; a < 3; a++) {
         num -= (double)nf[a] * (r->o[a] - ((double)v[a] + 0.5));
         den += (double)nf[a] * r->d[a];
     }
-    if (den == 0.0)
-        return -1.0;
-    double t = num / den;
-    if (!(t >= t_in && t <= t_out))
-        return -1.0;
-    return t;
+    /* s(t) = t * den - num */
+    const double s_in = t_in * den - num, s_out = t_out * den - num;
+    if (*side == 0)
+        *side = s_in > 0.0 ? 1 : -1;
+    if (!(s_in * *side > 0.0)) {
+        *t_hit = t_in;
+        return 1;
+    }
+    if (!(s_out * *side > 0.0)) {
+        const double tp = num / den; /* den != 0: s changed sign */
+        *t_hit = tp < t_in ? t_in : tp > t_out ? t_out : tp;
+        return 1;
+    }
+    return 0;
 }
 
 #if defined(__SSE4_1__)
@@ -283,6 +299,7 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     __m128d Txy, Tzw, TC = _mm_setzero_pd();
     double tc = 0.0;
     uint32_t steps = 0;
+    int side = 0; /* --refine: see refine_voxel */
 
     goto enter;
     for (;;) {
@@ -302,8 +319,8 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
                 const double te = _mm_cvtsd_f64(_mm_min_sd(m2, _mm_unpackhi_pd(m2, m2)));
                 uint32_t v[4];
                 _mm_storeu_si128((__m128i *)v, V);
-                double tp = plane_time(tree, r, n, v, tc, te < t_end ? te : t_end);
-                if (tp >= 0.0) {
+                double tp;
+                if (refine_voxel(tree, r, n, v, tc, te < t_end ? te : t_end, &side, &tp)) {
                     hit->hit = 1;
                     hit->voxel = n;
                     hit->t = r->t_base + tp;
@@ -323,8 +340,10 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
                                      steps, max_steps);
             if (steps > max_steps)
                 goto out;
+            side = 0;
             goto step;
         } else {
+            side = 0;
             goto step;
         }
         /* the cell becomes the parent: push it, then enter its child */
@@ -477,6 +496,7 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     uint32_t vx = 0, vy = 0, vz = 0, size = UINT32_C(1) << levels;
     double tx, ty, tz, tc = 0.0;
     uint32_t steps = 0;
+    int side = 0; /* --refine: see refine_voxel */
 
     goto enter;
     for (;;) {
@@ -537,13 +557,15 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             double te = tx < ty ? tx : ty;
             te = tz < te ? tz : te;
             const uint32_t v[3] = {vx, vy, vz};
-            double tp = plane_time(tree, r, vidx, v, tc, te < t_end ? te : t_end);
-            if (tp >= 0.0) {
+            double tp;
+            if (refine_voxel(tree, r, vidx, v, tc, te < t_end ? te : t_end, &side, &tp)) {
                 hit->hit = 1;
                 hit->voxel = vidx;
                 hit->t = r->t_base + tp;
                 break;
             }
+        } else {
+            side = 0;
         }
 
         /* leave the cell through its nearest exit planes */

@@ -97,7 +97,8 @@ int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r);
 
 typedef struct trace_opts {
     unsigned split;   /* K: empty cells of depth <= K are skipped whole; 0..L */
-    int refine;       /* intersect the voxel's stored plane, fall through on miss */
+    int refine;       /* hit where the ray crosses the stored planes of a run of
+                         occupied voxels (RENDER.md, "--refine"); 0: voxel entry */
 } trace_opts;
 
 typedef struct trace_hit {

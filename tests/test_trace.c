@@ -64,15 +64,31 @@ static long oracle(const trace_ray *r, unsigned levels, const uint32_t (*vox)[3]
     return best;
 }
 
-/* --refine oracle: among voxels with a non-empty interval [lo, hi), the one
- * with the smallest lo whose stored plane (n . (p - centre) = offset, voxel
- * units) is met at some t in [lo, hi]. Same arithmetic as the tracer. */
+/* --refine oracle, written from the rule of refine_voxel (trace.c) without
+ * the traversal: the voxels the ray occupies for a non-empty time [lo, hi)
+ * in the order of lo; a run is a sequence of them each starting where the
+ * previous one ends (no empty cell between). The ray hits the first voxel
+ * where it is across the plane at entry from the side it had when its run
+ * began (t = lo), or gets across before leaving (the plane time clamped to
+ * [lo, hi]). Same arithmetic as the tracer. */
+typedef struct span {
+    double lo, hi;
+    size_t i;
+} span;
+
+static int span_cmp(const void *a, const void *b)
+{
+    const span *x = a, *y = b;
+    return x->lo < y->lo ? -1 : x->lo > y->lo;
+}
+
 static long oracle_refine(const trace_ray *r, const oct_tree *tree, const uint32_t (*vox)[3],
                           size_t n, double *t_out)
 {
     const uint32_t lim = UINT32_C(1) << tree->levels;
-    long best = -1;
-    double best_lo = INFINITY, best_t = INFINITY;
+    span *sp = malloc((n ? n : 1) * sizeof *sp);
+    assert_non_null(sp);
+    size_t m = 0;
     for (size_t i = 0; i < n; i++) {
         double lo = 0.0, hi = INFINITY;
         int ok = 1;
@@ -88,8 +104,19 @@ static long oracle_refine(const trace_ray *r, const oct_tree *tree, const uint32
             lo = en > lo ? en : lo;
             hi = ex < hi ? ex : hi;
         }
-        if (!ok || !(lo < hi) || !(lo < best_lo))
-            continue;
+        if (hi > r->t_end)
+            hi = r->t_end;
+        if (ok && lo < hi)
+            sp[m++] = (span){lo, hi, i};
+    }
+    qsort(sp, m, sizeof *sp, span_cmp);
+    long best = -1;
+    double best_t = INFINITY;
+    int side = 0;
+    for (size_t j = 0; j < m && best < 0; j++) {
+        if (j == 0 || sp[j].lo != sp[j - 1].hi)
+            side = 0; /* an empty stretch before this voxel */
+        const size_t i = sp[j].i;
         /* the record of voxel i: attrs hold i + 1 */
         uint32_t rec = (uint32_t)i + 1;
         float nf[3];
@@ -99,17 +126,19 @@ static long oracle_refine(const trace_ray *r, const oct_tree *tree, const uint32
             num -= (double)nf[a] * (r->o[a] - ((double)vox[i][a] + 0.5));
             den += (double)nf[a] * r->d[a];
         }
-        if (den == 0.0)
-            continue;
-        double tp = num / den;
-        if (hi > r->t_end)
-            hi = r->t_end;
-        if (tp >= lo && tp <= hi) {
+        const double s_in = sp[j].lo * den - num, s_out = sp[j].hi * den - num;
+        if (side == 0)
+            side = s_in > 0.0 ? 1 : -1;
+        if (s_in * side <= 0.0) {
             best = (long)i;
-            best_lo = lo;
-            best_t = tp;
+            best_t = sp[j].lo;
+        } else if (s_out * side <= 0.0) {
+            double tp = num / den;
+            best = (long)i;
+            best_t = tp < sp[j].lo ? sp[j].lo : tp > sp[j].hi ? sp[j].hi : tp;
         }
     }
+    free(sp);
     *t_out = best_t;
     return best;
 }
