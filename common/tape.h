@@ -111,6 +111,20 @@ double tape_eval(const tape *t, double x, double y, double z, double *slots);
  * df/dy, df/dz. abs/min/max use the derivative of the branch taken. */
 double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dual *slots);
 
+/* tape_eval_grad at up to TAPE_LANES points at once, in structure-of-arrays
+ * form: lane l of f and g is, bit for bit, tape_eval_grad at (x[l], y[l],
+ * z[l]) for l < n (1 <= n <= TAPE_LANES). The arithmetic runs on every lane
+ * (the compiler vectorises it), so one pass over the tape serves n points;
+ * lanes from n on repeat lane 0. `slots` is the caller's scratch of t->n
+ * elements (common/tape_lanes.c). */
+#define TAPE_LANES 8
+typedef struct tape_dual_lanes {
+    double v[TAPE_LANES], d[3][TAPE_LANES];
+} tape_dual_lanes;
+void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
+                          const double y[TAPE_LANES], const double z[TAPE_LANES],
+                          double f[TAPE_LANES], double g[3][TAPE_LANES], tape_dual_lanes *slots);
+
 /* Sound enclosure of f over the box box[0] x box[1] x box[2]; *flags
  * receives INTERVAL_MAYBE_NAN when f may be undefined somewhere in the box
  * (see interval.h: then the result encloses f only where it is defined,

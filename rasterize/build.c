@@ -45,6 +45,10 @@ _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradie
                                  surface is resolved */
 #define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
 
+/* fmin and fmax without the library call; a NaN a gives b. */
+static double min2(double a, double b) { return a < b ? a : b; }
+static double max2(double a, double b) { return a > b ? a : b; }
+
 /* --- growable buffers -------------------------------------------------- */
 
 typedef struct buf {
@@ -107,6 +111,7 @@ typedef struct worker {
     interval *slots, *slots2;
     tape_idual *islots;
     tape_dual *dslots;
+    tape_dual_lanes *lslots;
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
@@ -116,6 +121,7 @@ typedef struct worker {
     interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
     double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */
     uint8_t *cf_ok;        /* [nsurf]: cf holds them for that surface (emit_voxel clears) */
+    double *cf8;           /* [nsurf * 8 * 4]: the same for the 8 children of a leaf-parent */
     uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
     task_out *out;
     build_stats st;
@@ -141,7 +147,9 @@ static int worker_init(worker *wk, const build_ctx *c)
     wk->grad_ok = calloc(depths * c->nsurf, 1);
     wk->cf = malloc((size_t)c->nsurf * 4 * sizeof *wk->cf);
     wk->cf_ok = calloc(c->nsurf, 1);
-    if (!wk->cf || !wk->cf_ok || !wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->scratch || !wk->prune ||
+    wk->cf8 = malloc((size_t)c->nsurf * 32 * sizeof *wk->cf8);
+    wk->lslots = malloc(len * sizeof *wk->lslots);
+    if (!wk->cf || !wk->cf_ok || !wk->cf8 || !wk->lslots || !wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->scratch || !wk->prune ||
         !wk->prune_konst ||
         !wk->tapes || !wk->act || !wk->nact || !wk->grad || !wk->grad_ok)
         return -1;
@@ -159,7 +167,7 @@ static void worker_free(worker *wk)
     free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act);
     free(wk->nact);
     free(wk->grad); free(wk->grad_ok);
-    free(wk->cf); free(wk->cf_ok);
+    free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->lslots);
 }
 
 /* --- cell tests ----------------------------------------------------------- */
@@ -214,24 +222,25 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
 static int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
                                       const interval box[3], const double centre[3], double fd)
 {
-    unsigned fl = 0;
-    interval gr[3];
+    double wlo = 0.0, whi = 0.0; /* G . (box - c) in plain double: the margin covers rounding */
     for (int k = 0; k < 3; k++) {
-        interval r = {interval_next_down(box[k].lo - centre[k]), interval_next_up(box[k].hi - centre[k])};
-        gr[k] = interval_mul(G[k], r, &fl);
+        double rl = box[k].lo - centre[k], rh = box[k].hi - centre[k];
+        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
+        wlo += min2(min2(p1, p2), min2(p3, p4));
+        whi += max2(max2(p1, p2), max2(p3, p4));
     }
-    if (fl)
-        return 0;
-    double wlo = gr[0].lo + gr[1].lo + gr[2].lo, whi = gr[0].hi + gr[1].hi + gr[2].hi;
     double m = RETEST_MARGIN * (whi - wlo);
     if (fd + m + wlo <= 0.0 && fd - m + whi >= 0.0) /* false on NaN or inf */
         return 0;
     interval fc;
     if (!eval_at_centre(wk, t, centre, &fc))
         return 0;
+    unsigned fl = 0;
     interval sum = fc;
-    for (int k = 0; k < 3; k++)
-        sum = interval_add(sum, gr[k], &fl);
+    for (int k = 0; k < 3; k++) {
+        interval r = {interval_next_down(box[k].lo - centre[k]), interval_next_up(box[k].hi - centre[k])};
+        sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
+    }
     return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
 }
 
@@ -361,8 +370,8 @@ static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], c
             break;
         double q[3], moved = 0.0;
         for (int k = 0; k < 3; k++) {
-            q[k] = fmin(fmax(p[k] - f / g2 * g[k], box[k].lo), box[k].hi);
-            moved = fmax(moved, fabs(q[k] - p[k]));
+            q[k] = min2(max2(p[k] - f / g2 * g[k], box[k].lo), box[k].hi); /* NaN gives lo */
+            moved = max2(moved, fabs(q[k] - p[k]));
         }
         if (moved < NEWTON_TOL * h)
             break; /* the linearisation at p below places the surface well enough */
@@ -391,7 +400,7 @@ static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], c
     d /= h;
     if (!isfinite(d))
         d = 0.0;
-    d = fmin(fmax(d, -HALF_DIAGONAL), HALF_DIAGONAL);
+    d = min2(max2(d, -HALF_DIAGONAL), HALF_DIAGONAL);
     return oct_voxel_pack(n, d);
 }
 
@@ -484,6 +493,53 @@ static int child_enclosures(worker *wk, const tape *t, const interval pbox[3], c
     return !fl;
 }
 
+/* Child i's box into box[i] (have[i] = 1), or have[i] = 0 when it lies
+ * outside the bounds; have[i] < 0 means not made yet. */
+static int child_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], unsigned i,
+                     interval box[8][3], double centre[8][3], int8_t have[8])
+{
+    if (have[i] < 0) {
+        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
+        have[i] = (int8_t)cell_box(c, depth + 1, cc, box[i], centre[i]);
+    }
+    return have[i];
+}
+
+/* For a leaf-parent: f and its gradient at the centres of the children that
+ * the mean-value form leaves to the centred re-test, surface by surface, one
+ * pass over the tape for all of them (tape_eval_grad_lanes), into wk->cf8. */
+static void leaf_centres(worker *wk, unsigned depth, const uint64_t cell[3], const uint8_t *ok,
+                         interval T[][8], interval box[8][3], double centre[8][3], int8_t have[8])
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        if (!ok[k])
+            continue;
+        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
+        double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+        for (unsigned i = 0; i < 8; i++) {
+            if (T[k][i].lo > 0.0 || T[k][i].hi < 0.0 || !child_box(c, depth, cell, i, box, centre, have))
+                continue;
+            x[n] = centre[i][0];
+            y[n] = centre[i][1];
+            z[n] = centre[i][2];
+            lane[n++] = i;
+        }
+        if (!n)
+            continue;
+        tape_eval_grad_lanes(&wk->tapes[(size_t)pidx * ns + s], n, x, y, z, f, g, wk->lslots);
+        wk->st.point_evals += n;
+        for (unsigned l = 0; l < n; l++) {
+            double *fg = wk->cf8 + ((size_t)s * 8 + lane[l]) * 4;
+            fg[0] = f[l];
+            fg[1] = g[0][l];
+            fg[2] = g[1][l];
+            fg[3] = g[2][l];
+        }
+    }
+}
+
 /* The finest levels: children are tested with child_enclosures, inheriting
  * the node's tapes (pruning no longer pays this deep); voxels are emitted,
  * deeper nodes recursed into. Where the mean-value form is not available for
@@ -509,11 +565,17 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                                           T[k]);
         wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
+    /* Most children fall to T alone: boxes are made lazily. */
+    interval boxes[8][3];
+    double centres[8][3];
+    int8_t have[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    int retest = depth + 1 == c->levels && depth + 1 >= MEAN_VALUE_ALONE_DEPTH;
+    if (retest)
+        leaf_centres(wk, depth, cell, ok, T, boxes, centres, have);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
-        interval box[3];
-        double centre[3];
-        int have_box = 0; /* most children fall to T alone: make boxes lazily */
+        const interval *box = boxes[i];
+        const double *centre = centres[i];
         unsigned n = 0;
         for (unsigned k = 0; k < wk->nact[pidx]; k++) {
             unsigned s = wk->act[(size_t)pidx * ns + k];
@@ -522,10 +584,11 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                 wk->st.taylor_drops++;
                 continue;
             }
-            if (!have_box) {
-                if (!cell_box(c, depth + 1, cc, box, centre))
-                    break; /* outside the bounds */
-                have_box = 1;
+            if (!child_box(c, depth, cell, i, boxes, centres, have))
+                break; /* outside the bounds */
+            if (retest && ok[k]) {
+                memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
+                wk->cf_ok[s] = 1;
             }
             if (!ok[k] || depth + 1 < MEAN_VALUE_ALONE_DEPTH
                     ? !cell_may_cross(wk, t, s, depth + 1, box, centre)

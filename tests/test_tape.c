@@ -467,6 +467,64 @@ static void test_random_trees(void **state)
     assert_true(pruned_shorter > 0);
 }
 
+/* Bitwise equality, NaN equal to NaN. */
+static int same_bits(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b));
+}
+
+/* tape_eval_grad_lanes gives, lane by lane, tape_eval_grad's bits: random
+ * trees (every operation) and the scenes, with 1 to TAPE_LANES points. */
+static void check_lanes(const tape *t, const double pts[][3], unsigned n, const char *what)
+{
+    static tape_dual_lanes lslots[MAXSLOTS];
+    static tape_dual duals[MAXSLOTS];
+    double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+    for (unsigned l = 0; l < n; l++) {
+        x[l] = pts[l][0];
+        y[l] = pts[l][1];
+        z[l] = pts[l][2];
+    }
+    tape_eval_grad_lanes(t, n, x, y, z, f, g, lslots);
+    for (unsigned l = 0; l < n; l++) {
+        double g1[3], f1 = tape_eval_grad(t, pts[l], g1, duals);
+        if (!same_bits(f[l], f1) || !same_bits(g[0][l], g1[0]) || !same_bits(g[1][l], g1[1]) ||
+            !same_bits(g[2][l], g1[2]))
+            fail_msg("%s lane %u of %u at (%a,%a,%a): %a (%a,%a,%a) vs %a (%a,%a,%a)", what, l, n,
+                     pts[l][0], pts[l][1], pts[l][2], f[l], g[0][l], g[1][l], g[2][l], f1, g1[0],
+                     g1[1], g1[2]);
+    }
+}
+
+static void test_grad_lanes(void **state)
+{
+    (void)state;
+    static char text[16384];
+    double pts[TAPE_LANES][3];
+    for (int n = 0; n < 2000 / SCALE; n++) {
+        scene *s = rand_tree(text, sizeof text);
+        interval box[3];
+        rand_tree_box(box);
+        unsigned lanes = 1 + (unsigned)n % TAPE_LANES;
+        for (unsigned l = 0; l < lanes; l++)
+            for (int a = 0; a < 3; a++)
+                pts[l][a] = in_box(box[a]);
+        check_lanes(&s->surfaces[0].tape, (const double(*)[3])pts, lanes, text);
+        scene_free(s);
+    }
+    for (size_t k = 0; k < NSCENES; k++) {
+        scene *s = load(scenes[k].path);
+        for (size_t j = 0; j < s->nsurfaces; j++)
+            for (int i = 0; i < 200; i++) {
+                unsigned lanes = 1 + (unsigned)i % TAPE_LANES;
+                for (unsigned l = 0; l < lanes; l++)
+                    rand_point(s, pts[l]);
+                check_lanes(&s->surfaces[j].tape, (const double(*)[3])pts, lanes, scenes[k].path);
+            }
+        scene_free(s);
+    }
+}
+
 /* tape_prune_const on random trees with an aggressive tolerance: on random
  * sub-boxes, the pruned tape's interval and mean-value enclosures must still
  * hold the full tape's values. */
@@ -629,6 +687,7 @@ int main(void)
         cmocka_unit_test(test_gradient_vs_differences),
         cmocka_unit_test(test_interval_scenes),
         cmocka_unit_test(test_random_trees),
+        cmocka_unit_test(test_grad_lanes),
         cmocka_unit_test(test_prune),
         cmocka_unit_test(test_prune_const_stays_sound),
         cmocka_unit_test(test_prune_const_drops_far_terms),

@@ -1,0 +1,149 @@
+/* tape_lanes_body.h: the body of the lane evaluator, included by
+ * tape_lanes.c once per lane count W (4 or 8) with FN its name and SCALE its
+ * helper, so that every lane loop has a constant trip count and becomes
+ * vector code without an epilogue. Lanes n..W-1 repeat lane 0. */
+#define LANES for (unsigned l = 0; l < W; l++)
+
+static void SCALE(tape_dual_lanes *restrict r, const tape_dual_lanes *restrict a,
+                  const double *restrict m)
+{
+    for (int j = 0; j < 3; j++)
+        LANES r->d[j][l] = a->d[j][l] * m[l];
+}
+
+static void FN(const tape *t, unsigned n, const double x[L], const double y[L], const double z[L],
+               double f[L], double g[3][L], tape_dual_lanes *s)
+{
+    const tape_insn *in = t->insn;
+    const tape_const *k = t->konst;
+    for (uint32_t i = 0, len = t->n; i < len; i++) {
+        tape_dual_lanes *restrict r = &s[i];
+        uint32_t op = in[i].op;
+        const tape_dual_lanes *restrict a = s + (op > TAPE_Z ? in[i].a : 0);
+        const tape_dual_lanes *restrict c = s + (op >= TAPE_ADD && op != TAPE_POWC ? in[i].b : 0);
+        double m[L];
+        switch ((tape_op)op) {
+        case TAPE_CONST: {
+            double v = k[in[i].a].v;
+            LANES r->v[l] = v;
+            memset(r->d, 0, sizeof r->d);
+            break;
+        }
+        case TAPE_X: case TAPE_Y: case TAPE_Z: {
+            int ax = (int)op - TAPE_X;
+            const double *p = ax == 0 ? x : ax == 1 ? y : z;
+            LANES
+                r->v[l] = p[l < n ? l : 0];
+            memset(r->d, 0, sizeof r->d);
+            LANES r->d[ax][l] = 1.0;
+            break;
+        }
+        case TAPE_NEG:
+            LANES { r->v[l] = -a->v[l]; m[l] = -1.0; }
+            SCALE(r, a, m);
+            break;
+        case TAPE_SQUARE:
+            LANES { r->v[l] = a->v[l] * a->v[l]; m[l] = 2.0 * a->v[l]; }
+            SCALE(r, a, m);
+            break;
+        case TAPE_SQRT:
+            for (unsigned l = 0; l < n; l++)
+                r->v[l] = sqrt(a->v[l]);
+            fill(r->v, n);
+            LANES m[l] = 0.5 / r->v[l];
+            SCALE(r, a, m);
+            break;
+        case TAPE_EXP:
+            for (unsigned l = 0; l < n; l++)
+                r->v[l] = exp(a->v[l]);
+            fill(r->v, n);
+            SCALE(r, a, r->v);
+            break;
+        case TAPE_LOG:
+            for (unsigned l = 0; l < n; l++)
+                r->v[l] = log(a->v[l]);
+            fill(r->v, n);
+            LANES m[l] = 1.0 / a->v[l];
+            SCALE(r, a, m);
+            break;
+        case TAPE_ABS:
+            LANES { r->v[l] = fabs(a->v[l]); m[l] = a->v[l] < 0.0 ? -1.0 : 1.0; }
+            SCALE(r, a, m);
+            break;
+        case TAPE_SIN:
+            for (unsigned l = 0; l < n; l++) {
+                r->v[l] = sin(a->v[l]);
+                m[l] = cos(a->v[l]);
+            }
+            fill(r->v, n);
+            fill(m, n);
+            SCALE(r, a, m);
+            break;
+        case TAPE_COS:
+            for (unsigned l = 0; l < n; l++) {
+                r->v[l] = cos(a->v[l]);
+                m[l] = -sin(a->v[l]);
+            }
+            fill(r->v, n);
+            fill(m, n);
+            SCALE(r, a, m);
+            break;
+        case TAPE_TAN:
+            for (unsigned l = 0; l < n; l++)
+                r->v[l] = tan(a->v[l]);
+            fill(r->v, n);
+            LANES m[l] = 1.0 + r->v[l] * r->v[l];
+            SCALE(r, a, m);
+            break;
+        case TAPE_ADD:
+            LANES r->v[l] = a->v[l] + 1.0 * c->v[l];
+            for (int j = 0; j < 3; j++)
+                LANES r->d[j][l] = a->d[j][l] + 1.0 * c->d[j][l];
+            break;
+        case TAPE_SUB:
+            LANES r->v[l] = a->v[l] + -1.0 * c->v[l];
+            for (int j = 0; j < 3; j++)
+                LANES r->d[j][l] = a->d[j][l] + -1.0 * c->d[j][l];
+            break;
+        case TAPE_MUL:
+            for (int j = 0; j < 3; j++)
+                LANES r->d[j][l] = a->d[j][l] * c->v[l] + a->v[l] * c->d[j][l];
+            LANES r->v[l] = a->v[l] * c->v[l];
+            break;
+        case TAPE_DIV:
+            LANES r->v[l] = a->v[l] / c->v[l];
+            for (int j = 0; j < 3; j++)
+                LANES r->d[j][l] = (a->d[j][l] - r->v[l] * c->d[j][l]) / c->v[l];
+            break;
+        case TAPE_MIN:
+        case TAPE_MAX:
+            LANES {
+                double v = op == TAPE_MIN ? point_min(a->v[l], c->v[l]) : point_max(a->v[l], c->v[l]);
+                const tape_dual_lanes *w = (v == a->v[l] || v != v) ? a : c;
+                for (int j = 0; j < 3; j++)
+                    r->d[j][l] = w->d[j][l];
+                r->v[l] = v;
+            }
+            break;
+        case TAPE_POWC: {
+            double e = k[in[i].b].v;
+            for (unsigned l = 0; l < n; l++) {
+                r->v[l] = pow(a->v[l], e);
+                m[l] = e * pow(a->v[l], e - 1.0);
+            }
+            fill(r->v, n);
+            fill(m, n);
+            SCALE(r, a, m);
+            break;
+        }
+        case TAPE_NOPS:
+            LANES r->v[l] = NAN;
+            break;
+        }
+    }
+    const tape_dual_lanes *r = &s[t->root];
+    memcpy(f, r->v, sizeof r->v);
+    memcpy(g, r->d, sizeof r->d);
+}
+
+#undef LANES
