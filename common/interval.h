@@ -204,6 +204,10 @@ static inline interval interval_mul(interval a, interval b, unsigned *flags)
         double hi = interval__max2(interval__max2(p1, p2), interval__max2(p3, p4));
         if (lo != 0.0 && hi != 0.0)
             return interval__mk(interval_next_down(lo), interval_next_up(hi));
+        int underflow = (p1 == 0.0 && a.lo != 0.0 && b.lo != 0.0) || (p2 == 0.0 && a.lo != 0.0 && b.hi != 0.0) ||
+                        (p3 == 0.0 && a.hi != 0.0 && b.lo != 0.0) || (p4 == 0.0 && a.hi != 0.0 && b.hi != 0.0);
+        return interval__mk(lo == 0.0 && !underflow ? 0.0 : interval_next_down(lo),
+                            hi == 0.0 && !underflow ? 0.0 : interval_next_up(hi));
     }
     if (interval__isnan(a) || interval__isnan(b))
         return interval__nan_flag(flags);

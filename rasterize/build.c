@@ -493,23 +493,56 @@ static int child_enclosures(worker *wk, const tape *t, const interval pbox[3], c
     return !fl;
 }
 
-/* Child i's box into box[i] (have[i] = 1), or have[i] = 0 when it lies
- * outside the bounds; have[i] < 0 means not made yet. */
-static int child_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], unsigned i,
-                     interval box[8][3], double centre[8][3], int8_t have[8])
+/* The boxes of a node's children, made lazily: a child's box is its lower
+ * or upper half on each axis, each half rounded as cell_box rounds it. */
+typedef struct child_boxes {
+    interval half[3][2];
+    double mid[3][2];
+    uint8_t half_ok[3][2]; /* that half lies inside the bounds */
+    int8_t have[8];        /* child's box made (1), outside the bounds (0), not yet (-1) */
+    interval box[8][3];
+    double centre[8][3];
+} child_boxes;
+
+static void child_boxes_init(const build_ctx *c, unsigned depth, const uint64_t cell[3],
+                             child_boxes *cb)
 {
-    if (have[i] < 0) {
-        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
-        have[i] = (int8_t)cell_box(c, depth + 1, cc, box[i], centre[i]);
+    double h = c->cell_edge[depth + 1];
+    for (int k = 0; k < 3; k++)
+        for (unsigned b = 0; b < 2; b++) {
+            uint64_t ck = 2 * cell[k] + b;
+            double lo = interval_next_down(c->origin[k] + (double)ck * h);
+            double hi = interval_next_up(c->origin[k] + (double)(ck + 1) * h);
+            if (hi > c->bmax[k])
+                hi = c->bmax[k];
+            cb->half_ok[k][b] = lo <= hi;
+            cb->half[k][b].lo = lo;
+            cb->half[k][b].hi = hi;
+            cb->mid[k][b] = 0.5 * (lo + hi);
+        }
+    memset(cb->have, -1, sizeof cb->have);
+}
+
+/* 1 when child i lies (in part) inside the bounds; then its box is made. */
+static int child_box(child_boxes *cb, unsigned i)
+{
+    if (cb->have[i] < 0) {
+        unsigned b[3] = {i & 1, (i >> 1) & 1, i >> 2};
+        cb->have[i] = 1;
+        for (int k = 0; k < 3; k++) {
+            cb->have[i] &= cb->half_ok[k][b[k]];
+            cb->box[i][k] = cb->half[k][b[k]];
+            cb->centre[i][k] = cb->mid[k][b[k]];
+        }
     }
-    return have[i];
+    return cb->have[i];
 }
 
 /* For a leaf-parent: f and its gradient at the centres of the children that
  * the mean-value form leaves to the centred re-test, surface by surface, one
  * pass over the tape for all of them (tape_eval_grad_lanes), into wk->cf8. */
-static void leaf_centres(worker *wk, unsigned depth, const uint64_t cell[3], const uint8_t *ok,
-                         interval T[][8], interval box[8][3], double centre[8][3], int8_t have[8])
+static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+                         child_boxes *cb)
 {
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
@@ -519,11 +552,11 @@ static void leaf_centres(worker *wk, unsigned depth, const uint64_t cell[3], con
         unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
         double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
         for (unsigned i = 0; i < 8; i++) {
-            if (T[k][i].lo > 0.0 || T[k][i].hi < 0.0 || !child_box(c, depth, cell, i, box, centre, have))
+            if (T[k][i].lo > 0.0 || T[k][i].hi < 0.0 || !child_box(cb, i))
                 continue;
-            x[n] = centre[i][0];
-            y[n] = centre[i][1];
-            z[n] = centre[i][2];
+            x[n] = cb->centre[i][0];
+            y[n] = cb->centre[i][1];
+            z[n] = cb->centre[i][2];
             lane[n++] = i;
         }
         if (!n)
@@ -565,17 +598,15 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                                           T[k]);
         wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
-    /* Most children fall to T alone: boxes are made lazily. */
-    interval boxes[8][3];
-    double centres[8][3];
-    int8_t have[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    child_boxes cb; /* most children fall to T alone: boxes are made lazily */
+    child_boxes_init(c, depth, cell, &cb);
     int retest = depth + 1 == c->levels && depth + 1 >= MEAN_VALUE_ALONE_DEPTH;
     if (retest)
-        leaf_centres(wk, depth, cell, ok, T, boxes, centres, have);
+        leaf_centres(wk, depth, ok, T, &cb);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
-        const interval *box = boxes[i];
-        const double *centre = centres[i];
+        const interval *box = cb.box[i];
+        const double *centre = cb.centre[i];
         unsigned n = 0;
         for (unsigned k = 0; k < wk->nact[pidx]; k++) {
             unsigned s = wk->act[(size_t)pidx * ns + k];
@@ -584,7 +615,7 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                 wk->st.taylor_drops++;
                 continue;
             }
-            if (!child_box(c, depth, cell, i, boxes, centres, have))
+            if (!child_box(&cb, i))
                 break; /* outside the bounds */
             if (retest && ok[k]) {
                 memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
