@@ -25,6 +25,13 @@ static void fill(double *v, unsigned n)
         v[l] = v[0];
 }
 
+#define W 2
+#define FN eval2
+#define SCALE scale2
+#include "common/tape_lanes_body.h"
+#undef W
+#undef FN
+#undef SCALE
 #define W 4
 #define FN eval4
 #define SCALE scale4
@@ -37,11 +44,13 @@ static void fill(double *v, unsigned n)
 #define SCALE scale8
 #include "common/tape_lanes_body.h"
 
-/* Four lanes when they suffice: the arithmetic runs on every lane. */
+/* The fewest lanes that hold n: the arithmetic runs on every lane. */
 void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[L], const double y[L],
                           const double z[L], double f[L], double g[3][L], tape_dual_lanes *s)
 {
-    if (n <= 4)
+    if (n <= 2)
+        eval2(t, n, x, y, z, f, g, s);
+    else if (n <= 4)
         eval4(t, n, x, y, z, f, g, s);
     else
         eval8(t, n, x, y, z, f, g, s);

@@ -1,5 +1,5 @@
 /* tape_lanes_body.h: the body of the lane evaluator, included by
- * tape_lanes.c once per lane count W (4 or 8) with FN its name and SCALE its
+ * tape_lanes.c once per lane count W (2, 4 or 8) with FN its name and SCALE its
  * helper, so that every lane loop has a constant trip count and becomes
  * vector code without an epilogue. Lanes n..W-1 repeat lane 0. */
 #define LANES for (unsigned l = 0; l < W; l++)
@@ -26,7 +26,8 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
         case TAPE_CONST: {
             double v = k[in[i].a].v;
             LANES r->v[l] = v;
-            memset(r->d, 0, sizeof r->d);
+            for (int j = 0; j < 3; j++)
+                LANES r->d[j][l] = 0.0;
             break;
         }
         case TAPE_X: case TAPE_Y: case TAPE_Z: {
@@ -34,7 +35,8 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             const double *p = ax == 0 ? x : ax == 1 ? y : z;
             LANES
                 r->v[l] = p[l < n ? l : 0];
-            memset(r->d, 0, sizeof r->d);
+            for (int j = 0; j < 3; j++)
+                LANES r->d[j][l] = 0.0;
             LANES r->d[ax][l] = 1.0;
             break;
         }

@@ -120,7 +120,7 @@ typedef struct worker {
     unsigned *nact;        /* [levels + 2] */
     interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
     double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */
-    uint8_t *cf_ok;        /* [nsurf]: cf holds them for that surface (emit_voxel clears) */
+    uint8_t *cf_ok;        /* [nsurf]: cf holds them for that surface (voxel_surface clears) */
     double *cf8;           /* [nsurf * 8 * 4]: the same for the 8 children of a leaf-parent */
     uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
     task_out *out;
@@ -347,41 +347,58 @@ static unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint6
 
 static int finite3(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
-/* Normal and plane offset of the voxel for surface tape t: guarded Newton
+/* Normal and plane offset of a voxel for a surface: guarded Newton
  * steps from the centre towards f = 0, kept inside the voxel; the normal is
  * the normalised gradient there, the offset the signed distance (in voxel
  * edges) from the centre to the linearised surface along it. A gradient that
  * is zero or not finite there and at the centre falls back to +z with offset
  * 0 (counted in normal_fallbacks). */
-static uint32_t voxel_record(worker *wk, const tape *t, const interval box[3], const double centre[3],
-                             double h, const double *fg_centre)
+typedef struct newton {
+    double p[3], f, g[3]; /* the iterate and f, grad f there */
+    double fg[4];         /* f and grad f at the centre */
+    int step;
+} newton;
+
+static void newton_start(newton *nw, const double centre[3], const double fg_centre[4])
 {
-    double p[3] = {centre[0], centre[1], centre[2]}, g[3], f = 0.0;
-    for (int step = 0;; step++) {
-        if (step == 0 && fg_centre) {
-            f = fg_centre[0];
-            memcpy(g, fg_centre + 1, sizeof g);
-        } else {
-            f = tape_eval_grad(t, p, g, wk->dslots);
-            wk->st.point_evals++;
-        }
-        double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if (step == NEWTON_STEPS || !(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
-            break;
-        double q[3], moved = 0.0;
-        for (int k = 0; k < 3; k++) {
-            q[k] = min2(max2(p[k] - f / g2 * g[k], box[k].lo), box[k].hi); /* NaN gives lo */
-            moved = max2(moved, fabs(q[k] - p[k]));
-        }
-        if (moved < NEWTON_TOL * h)
-            break; /* the linearisation at p below places the surface well enough */
-        memcpy(p, q, sizeof p);
+    memcpy(nw->p, centre, sizeof nw->p);
+    memcpy(nw->fg, fg_centre, sizeof nw->fg);
+    nw->f = fg_centre[0];
+    memcpy(nw->g, fg_centre + 1, sizeof nw->g);
+    nw->step = 0;
+}
+
+/* With f and its gradient at the iterate known: 1 when the iterate moved
+ * and they are wanted at the new one, 0 when the iteration has stopped. */
+static int newton_advance(newton *nw, const interval box[3], double h)
+{
+    double f = nw->f, *g = nw->g, *p = nw->p;
+    double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (nw->step == NEWTON_STEPS || !(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
+        return 0;
+    double q[3], moved = 0.0;
+    for (int k = 0; k < 3; k++) {
+        q[k] = min2(max2(p[k] - f / g2 * g[k], box[k].lo), box[k].hi); /* NaN gives lo */
+        moved = max2(moved, fabs(q[k] - p[k]));
     }
+    if (moved < NEWTON_TOL * h)
+        return 0; /* the linearisation at p places the surface well enough */
+    memcpy(p, q, sizeof q);
+    nw->step++;
+    return 1;
+}
+
+/* The voxel's record from where the iteration stopped. */
+static uint32_t newton_record(worker *wk, const newton *nw, const double centre[3], double h)
+{
+    double p[3], g[3], f = nw->f;
+    memcpy(p, nw->p, sizeof p);
+    memcpy(g, nw->g, sizeof g);
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g) || !isfinite(f)) {
         memcpy(p, centre, sizeof p);
-        f = tape_eval_grad(t, p, g, wk->dslots);
-        wk->st.point_evals++;
+        f = nw->fg[0];
+        memcpy(g, nw->fg + 1, sizeof g);
         g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
         if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g)) {
             wk->st.normal_fallbacks++;
@@ -416,12 +433,12 @@ static const double *centre_fg(worker *wk, const tape *t, unsigned s, const doub
     return fg;
 }
 
-/* Appends the voxel's record; with several surfaces it belongs to the one
- * nearest its centre by the first-order distance |f| / |grad f|. */
-static int emit_voxel(worker *wk, const interval box[3], const double centre[3])
+/* The surface a voxel belongs to (lists at index idx): with several, the
+ * one nearest its centre by the first-order distance |f| / |grad f|. Starts
+ * its Newton iteration and forgets the centre values (wk->cf). */
+static unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw)
 {
-    const build_ctx *c = wk->c;
-    unsigned idx = c->levels + 1, ns = c->nsurf;
+    const unsigned ns = wk->c->nsurf;
     unsigned best = wk->act[(size_t)idx * ns];
     if (wk->nact[idx] > 1) {
         double best_dist = INFINITY;
@@ -438,19 +455,38 @@ static int emit_voxel(worker *wk, const interval box[3], const double centre[3])
             }
         }
     }
-    const tape *bt = &wk->tapes[(size_t)idx * ns + best];
-    uint32_t rec = voxel_record(wk, bt, box, centre, c->cell_edge[c->levels],
-                                centre_fg(wk, bt, best, centre));
+    newton_start(nw, centre, centre_fg(wk, &wk->tapes[(size_t)idx * ns + best], best, centre));
     for (unsigned k = 0; k < wk->nact[idx]; k++)
         wk->cf_ok[wk->act[(size_t)idx * ns + k]] = 0;
-    uint8_t surf = (uint8_t)best;
+    return best;
+}
+
+static int push_voxel(worker *wk, uint32_t rec, unsigned surface)
+{
+    uint8_t surf = (uint8_t)surface;
     if (buf_push(&wk->out->voxels, &rec, sizeof rec) ||
-        (ns > 1 && buf_push(&wk->out->surfaces, &surf, 1))) {
+        (wk->c->nsurf > 1 && buf_push(&wk->out->surfaces, &surf, 1))) {
         wk->failed = 1;
         return 0;
     }
     wk->st.voxels++;
     return 1;
+}
+
+/* Appends the voxel's record (lists at index levels + 1). */
+static int emit_voxel(worker *wk, const interval box[3], const double centre[3])
+{
+    const build_ctx *c = wk->c;
+    unsigned idx = c->levels + 1;
+    newton nw;
+    unsigned best = voxel_surface(wk, idx, centre, &nw);
+    const tape *t = &wk->tapes[(size_t)idx * c->nsurf + best];
+    double h = c->cell_edge[c->levels];
+    while (newton_advance(&nw, box, h)) {
+        nw.f = tape_eval_grad(t, nw.p, nw.g, wk->dslots);
+        wk->st.point_evals++;
+    }
+    return push_voxel(wk, newton_record(wk, &nw, centre, h), best);
 }
 
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3]);
@@ -538,6 +574,48 @@ static int child_box(child_boxes *cb, unsigned i)
     return cb->have[i];
 }
 
+/* The records of a leaf-parent's np voxels (children child[j], surfaces
+ * surf[j], iterations started in nw[j]), appended in child order: the
+ * Newton steps of all of them that still move are evaluated together, one
+ * pass over the tape per round (tape_eval_grad_lanes). */
+static void emit_voxels(worker *wk, unsigned pidx, const child_boxes *cb, const uint8_t *child,
+                        const uint8_t *surf, newton *nw, unsigned np)
+{
+    const build_ctx *c = wk->c;
+    double h = c->cell_edge[c->levels];
+    uint8_t live[8];
+    for (unsigned j = 0; j < np; j++)
+        live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
+    for (;;) {
+        unsigned first = 0;
+        while (first < np && !live[first])
+            first++;
+        if (first == np)
+            break;
+        unsigned s = surf[first], n = 0, lane[8];
+        double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+        for (unsigned j = first; j < np; j++)
+            if (live[j] && surf[j] == s) {
+                x[n] = nw[j].p[0];
+                y[n] = nw[j].p[1];
+                z[n] = nw[j].p[2];
+                lane[n++] = j;
+            }
+        tape_eval_grad_lanes(&wk->tapes[(size_t)pidx * c->nsurf + s], n, x, y, z, f, g, wk->lslots);
+        wk->st.point_evals += n;
+        for (unsigned l = 0; l < n; l++) {
+            newton *w = &nw[lane[l]];
+            w->f = f[l];
+            w->g[0] = g[0][l];
+            w->g[1] = g[1][l];
+            w->g[2] = g[2][l];
+            live[lane[l]] = (uint8_t)newton_advance(w, cb->box[child[lane[l]]], h);
+        }
+    }
+    for (unsigned j = 0; j < np && !wk->failed; j++)
+        push_voxel(wk, newton_record(wk, &nw[j], cb->centre[child[j]], h), surf[j]);
+}
+
 /* For a leaf-parent: f and its gradient at the centres of the children that
  * the mean-value form leaves to the centred re-test, surface by surface, one
  * pass over the tape for all of them (tape_eval_grad_lanes), into wk->cf8. */
@@ -601,6 +679,9 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     child_boxes cb; /* most children fall to T alone: boxes are made lazily */
     child_boxes_init(c, depth, cell, &cb);
     int retest = depth + 1 == c->levels && depth + 1 >= MEAN_VALUE_ALONE_DEPTH;
+    newton nw[8];
+    uint8_t child[8], surf[8];
+    unsigned np = 0;
     if (retest)
         leaf_centres(wk, depth, ok, T, &cb);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
@@ -634,10 +715,20 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
             wk->tapes[(size_t)cidx * ns + s] = *t;
         }
         wk->nact[cidx] = n;
-        if (n && (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc)))
+        if (!n)
+            continue;
+        if (retest) { /* records made below, all together */
+            child[np] = (uint8_t)i;
+            surf[np] = (uint8_t)voxel_surface(wk, cidx, centre, &nw[np]);
+            np++;
             mask |= (uint8_t)(1u << i);
+        } else if (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc)) {
+            mask |= (uint8_t)(1u << i);
+        }
     }
-    return mask;
+    if (np)
+        emit_voxels(wk, pidx, &cb, child, surf, nw, np);
+    return wk->failed ? 0 : mask;
 }
 
 /* Builds the subtree of a cell already tested non-empty; returns its child
