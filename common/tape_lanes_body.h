@@ -3,6 +3,9 @@
  * helper, so that every lane loop has a constant trip count and becomes
  * vector code without an epilogue. Lanes n..W-1 repeat lane 0. */
 #define LANES for (unsigned l = 0; l < W; l++)
+/* The operand slots, formed only where the fields are slots. */
+#define A ((const tape_dual_lanes *restrict)(s + in[i].a))
+#define C ((const tape_dual_lanes *restrict)(s + in[i].b))
 
 static void SCALE(tape_dual_lanes *restrict r, const tape_dual_lanes *restrict a,
                   const double *restrict m)
@@ -19,8 +22,6 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
     for (uint32_t i = 0, len = t->n; i < len; i++) {
         tape_dual_lanes *restrict r = &s[i];
         uint32_t op = in[i].op;
-        const tape_dual_lanes *restrict a = s + (op > TAPE_Z ? in[i].a : 0);
-        const tape_dual_lanes *restrict c = s + (op >= TAPE_ADD && op != TAPE_POWC ? in[i].b : 0);
         double m[L];
         switch ((tape_op)op) {
         case TAPE_CONST: {
@@ -41,87 +42,87 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             break;
         }
         case TAPE_NEG:
-            LANES { r->v[l] = -a->v[l]; m[l] = -1.0; }
-            SCALE(r, a, m);
+            LANES { r->v[l] = -A->v[l]; m[l] = -1.0; }
+            SCALE(r, A, m);
             break;
         case TAPE_SQUARE:
-            LANES { r->v[l] = a->v[l] * a->v[l]; m[l] = 2.0 * a->v[l]; }
-            SCALE(r, a, m);
+            LANES { r->v[l] = A->v[l] * A->v[l]; m[l] = 2.0 * A->v[l]; }
+            SCALE(r, A, m);
             break;
         case TAPE_SQRT:
             for (unsigned l = 0; l < n; l++)
-                r->v[l] = sqrt(a->v[l]);
+                r->v[l] = sqrt(A->v[l]);
             fill(r->v, n);
             LANES m[l] = 0.5 / r->v[l];
-            SCALE(r, a, m);
+            SCALE(r, A, m);
             break;
         case TAPE_EXP:
             for (unsigned l = 0; l < n; l++)
-                r->v[l] = exp(a->v[l]);
+                r->v[l] = exp(A->v[l]);
             fill(r->v, n);
-            SCALE(r, a, r->v);
+            SCALE(r, A, r->v);
             break;
         case TAPE_LOG:
             for (unsigned l = 0; l < n; l++)
-                r->v[l] = log(a->v[l]);
+                r->v[l] = log(A->v[l]);
             fill(r->v, n);
-            LANES m[l] = 1.0 / a->v[l];
-            SCALE(r, a, m);
+            LANES m[l] = 1.0 / A->v[l];
+            SCALE(r, A, m);
             break;
         case TAPE_ABS:
-            LANES { r->v[l] = fabs(a->v[l]); m[l] = a->v[l] < 0.0 ? -1.0 : 1.0; }
-            SCALE(r, a, m);
+            LANES { r->v[l] = fabs(A->v[l]); m[l] = A->v[l] < 0.0 ? -1.0 : 1.0; }
+            SCALE(r, A, m);
             break;
         case TAPE_SIN:
             for (unsigned l = 0; l < n; l++) {
-                r->v[l] = sin(a->v[l]);
-                m[l] = cos(a->v[l]);
+                r->v[l] = sin(A->v[l]);
+                m[l] = cos(A->v[l]);
             }
             fill(r->v, n);
             fill(m, n);
-            SCALE(r, a, m);
+            SCALE(r, A, m);
             break;
         case TAPE_COS:
             for (unsigned l = 0; l < n; l++) {
-                r->v[l] = cos(a->v[l]);
-                m[l] = -sin(a->v[l]);
+                r->v[l] = cos(A->v[l]);
+                m[l] = -sin(A->v[l]);
             }
             fill(r->v, n);
             fill(m, n);
-            SCALE(r, a, m);
+            SCALE(r, A, m);
             break;
         case TAPE_TAN:
             for (unsigned l = 0; l < n; l++)
-                r->v[l] = tan(a->v[l]);
+                r->v[l] = tan(A->v[l]);
             fill(r->v, n);
             LANES m[l] = 1.0 + r->v[l] * r->v[l];
-            SCALE(r, a, m);
+            SCALE(r, A, m);
             break;
         case TAPE_ADD:
-            LANES r->v[l] = a->v[l] + 1.0 * c->v[l];
+            LANES r->v[l] = A->v[l] + 1.0 * C->v[l];
             for (int j = 0; j < 3; j++)
-                LANES r->d[j][l] = a->d[j][l] + 1.0 * c->d[j][l];
+                LANES r->d[j][l] = A->d[j][l] + 1.0 * C->d[j][l];
             break;
         case TAPE_SUB:
-            LANES r->v[l] = a->v[l] + -1.0 * c->v[l];
+            LANES r->v[l] = A->v[l] + -1.0 * C->v[l];
             for (int j = 0; j < 3; j++)
-                LANES r->d[j][l] = a->d[j][l] + -1.0 * c->d[j][l];
+                LANES r->d[j][l] = A->d[j][l] + -1.0 * C->d[j][l];
             break;
         case TAPE_MUL:
             for (int j = 0; j < 3; j++)
-                LANES r->d[j][l] = a->d[j][l] * c->v[l] + a->v[l] * c->d[j][l];
-            LANES r->v[l] = a->v[l] * c->v[l];
+                LANES r->d[j][l] = A->d[j][l] * C->v[l] + A->v[l] * C->d[j][l];
+            LANES r->v[l] = A->v[l] * C->v[l];
             break;
         case TAPE_DIV:
-            LANES r->v[l] = a->v[l] / c->v[l];
+            LANES r->v[l] = A->v[l] / C->v[l];
             for (int j = 0; j < 3; j++)
-                LANES r->d[j][l] = (a->d[j][l] - r->v[l] * c->d[j][l]) / c->v[l];
+                LANES r->d[j][l] = (A->d[j][l] - r->v[l] * C->d[j][l]) / C->v[l];
             break;
         case TAPE_MIN:
         case TAPE_MAX:
             LANES {
-                double v = op == TAPE_MIN ? point_min(a->v[l], c->v[l]) : point_max(a->v[l], c->v[l]);
-                const tape_dual_lanes *w = (v == a->v[l] || v != v) ? a : c;
+                double v = op == TAPE_MIN ? point_min(A->v[l], C->v[l]) : point_max(A->v[l], C->v[l]);
+                const tape_dual_lanes *w = (v == A->v[l] || v != v) ? A : C;
                 for (int j = 0; j < 3; j++)
                     r->d[j][l] = w->d[j][l];
                 r->v[l] = v;
@@ -130,12 +131,12 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
         case TAPE_POWC: {
             double e = k[in[i].b].v;
             for (unsigned l = 0; l < n; l++) {
-                r->v[l] = pow(a->v[l], e);
-                m[l] = e * pow(a->v[l], e - 1.0);
+                r->v[l] = pow(A->v[l], e);
+                m[l] = e * pow(A->v[l], e - 1.0);
             }
             fill(r->v, n);
             fill(m, n);
-            SCALE(r, a, m);
+            SCALE(r, A, m);
             break;
         }
         case TAPE_NOPS:
@@ -149,3 +150,5 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
 }
 
 #undef LANES
+#undef A
+#undef C
