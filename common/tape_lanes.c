@@ -10,11 +10,6 @@
 
 #define L TAPE_LANES
 
-/* GCC's -O2 cost model leaves most lane loops scalar; ask for its full one. */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("vect-cost-model=dynamic")
-#endif
-
 static double point_min(double a, double b) { return (a < b || a != a) ? a : b; }
 static double point_max(double a, double b) { return (a > b || a != a) ? a : b; }
 
