@@ -45,7 +45,9 @@ static double sample(const double d[3], const double n[3])
     for (int a = 0; a < 3; a++)
         o[a] = 64.0 * urand();
     const double nd = dot(n, d);
-    const double c = dot(n, o) + nd * (8.0 + 4.0 * urand()); /* 8..12 voxels ahead */
+    /* start 2.5..6.5 voxels from the plane, normal distance: the first voxel
+     * is never in the shell, whatever the incidence */
+    const double c = dot(n, o) + nd * (2.5 + 4.0 * urand()) / fabs(nd);
     const double t_plane = (c - dot(n, o)) / nd;
     const double h = 0.5 * (fabs(n[0]) + fabs(n[1]) + fabs(n[2]));
     long v[3];

@@ -54,9 +54,9 @@ typedef struct beam_item {
 
 typedef struct beam_walk {
     const oct_tree *tree;
-    const camera *cam;
     pyramid p;
-    double margin;
+    double o[3];   /* the eye in grid units (voxels), as the traversal has it */
+    double margin; /* voxels added to every half edge */
     unsigned lim, flip;
 } beam_walk;
 
@@ -69,7 +69,7 @@ typedef struct beam_walk {
 static double beam_extreme(const beam_walk *bw, int far)
 {
     const oct_tree *tree = bw->tree;
-    const double *eye = bw->cam->eye;
+    const double *o = bw->o;
     double best = far ? -INFINITY : INFINITY;
     beam_item stack[8 * OCT_MAX_LEVELS + 1];
     unsigned sp = 0;
@@ -79,7 +79,7 @@ static double beam_extreme(const beam_walk *bw, int far)
         const beam_item it = stack[--sp];
         const oct_group *g = &tree->groups[it.depth][it.node >> 3];
         const unsigned mask = g->mask[it.node & 7u];
-        const double s = tree->edge / (double)(UINT64_C(1) << (it.depth + 1)); /* child edge */
+        const double s = (double)(UINT32_C(1) << (tree->levels - it.depth - 1)); /* child edge */
         const double h = 0.5 * s + bw->margin;
         /* pushed in reverse order: the child to look at first is popped first */
         for (int k = 7; k >= 0; k--) {
@@ -90,7 +90,7 @@ static double beam_extreme(const beam_walk *bw, int far)
             double ctr[3], d2 = 0.0;
             for (int i = 0; i < 3; i++) {
                 cell[i] = 2u * it.cell[i] + (c >> i & 1u);
-                ctr[i] = tree->origin[i] + ((double)cell[i] + 0.5) * s - eye[i];
+                ctr[i] = ((double)cell[i] + 0.5) * s - o[i]; /* one rounding */
                 const double e = far ? fabs(ctr[i]) + h : fabs(ctr[i]) - h;
                 if (e > 0.0)
                     d2 += e * e;
@@ -111,6 +111,11 @@ static double beam_extreme(const beam_walk *bw, int far)
     return best;
 }
 
+/* Grid distance -> the caller's t (unit directions), widened outward by a
+ * relative 2^-40 for the division and a direction's length of 1 +- ulps. */
+static double t_down(double dist, double scale) { return dist / scale * (1.0 - 0x1p-40); }
+static double t_up(double dist, double scale) { return dist / scale * (1.0 + 0x1p-40); }
+
 int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, unsigned depth,
                 double *t_lo, double *t_hi)
 {
@@ -119,20 +124,27 @@ int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, un
         return 0;
     beam_walk bw;
     bw.tree = tree;
-    bw.cam = cam;
     bw.lim = depth < 1 ? 1 : depth > levels ? levels : depth;
     pyramid_init(&bw.p, cam, b);
-    bw.margin = BEAM_MARGIN * tree->edge;
+    /* Grid units, the eye placed as the traversal places it: cell centres
+     * are exact and, relative to the eye, carry one rounding of
+     * ulp(max(|o|, N)), as the traversal's plane times do. The margin covers
+     * both with room to spare: 2^-12 voxel plus 2^-40 of that magnitude. */
+    const double n = (double)(UINT32_C(1) << levels), scale = n / tree->edge;
+    double big = n;
     bw.flip = 0; /* the child nearest the eye along the view direction */
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < 3; i++) {
+        bw.o[i] = (cam->eye[i] - tree->origin[i]) * scale;
+        if (!isfinite(bw.o[i]))
+            return 0; /* trace_eye_init refuses such an eye: every ray misses */
+        big = fmax(big, fabs(bw.o[i]));
         bw.flip |= (cam->forward[i] < 0.0 ? 1u : 0u) << i;
+    }
+    bw.margin = 0x1p-12 + big * 0x1p-40;
     const double lo = beam_extreme(&bw, 0);
     if (!(lo < INFINITY))
         return 0;
-    const double hi = beam_extreme(&bw, 1);
-    /* a unit direction of length 1 +- a few ulp: t and distance differ by
-     * that factor; the margin in the box covers the rest */
-    *t_lo = lo * (1.0 - 0x1p-40);
-    *t_hi = hi * (1.0 + 0x1p-40);
+    *t_lo = t_down(lo, scale);
+    *t_hi = t_up(beam_extreme(&bw, 1), scale);
     return 1;
 }

@@ -8,21 +8,22 @@
  *
  * Exactness. The test is conservative: a cell is rejected only when one of
  * the pyramid's five bounding half-spaces (four sides through the eye, one
- * "in front of the eye") holds none of the cell, with the cell grown by
- * BEAM_MARGIN of the cube's edge on every side (far above the rounding of
- * camera_ray_uv and of the traversal's plane times). The window is the
- * nearest and farthest distance from the eye to the kept cells, also
- * widened. A unit ray at parameter t is at distance t from the eye, so it
- * can be in an occupied voxel only inside the window: traced inside it, a ray
- * meets the same voxels at the same plane times as traced whole, and the
+ * "in front of the eye") holds none of the cell, with the cell grown on every
+ * side by a margin far above the rounding of the camera's directions and of
+ * the traversal's plane times. The walk works in grid units relative to the
+ * eye placed as the traversal places it, so that rounding is
+ * ulp(max(|eye|, N)) voxels whatever the cube's origin; the margin is 2^-12
+ * voxel plus 2^-40 of that magnitude. The window is the nearest and farthest
+ * distance from the eye to the kept cells, also widened. A unit ray at
+ * parameter t is at distance t from the eye, so it can be in an occupied
+ * voxel only inside the window: traced inside it, a ray meets the same
+ * voxels at the same plane times as traced whole, and the
  * image is the same (tests/test_frame.c compares the two, byte for byte). */
 #ifndef BEAM_H
 #define BEAM_H
 
 #include "common/camera.h"
 #include "format/oct.h"
-
-#define BEAM_MARGIN 0x1p-30 /* of the cube's edge: < 2^-10 voxel at 20 levels */
 
 typedef struct beam_block {
     double u0, u1, v0, v1; /* camera_u / camera_v of the block's extreme pixel centres */
