@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "common/image.h"
+#include "render/beam.h"
 
 typedef struct frame_shared {
     const frame_job *job;
@@ -69,54 +70,96 @@ static inline uint8_t srgb8_fast(float x)
     return (uint8_t)k;
 }
 
+/* Traces, shades and stores pixel (i, j); r is its prepared ray, or NULL
+ * for a ray known to miss. */
+static inline void render_pixel(const frame_job *job, uint32_t i, uint32_t j, const double dir[3],
+                                const trace_ray *r, uint64_t *hits, uint64_t *steps)
+{
+    trace_hit h;
+    if (r) {
+        trace_ray_prepared(job->tree, &job->opts, r, &h);
+    } else { /* trace_ray_cast's miss */
+        h.hit = 0;
+        h.t = INFINITY;
+        h.steps = 0;
+    }
+    float rgb[3], n[3];
+    shade_hit(job->tree, &job->shade, &h, dir, rgb, n);
+    const size_t px = (size_t)j * job->cam->width + i;
+    for (int a = 0; a < 3; a++)
+        job->rgb[3 * px + (size_t)a] = srgb8_fast(rgb[a]);
+    if (job->depth)
+        job->depth[px] = h.t > FLT_MAX ? (isinf(h.t) ? INFINITY : FLT_MAX) : (float)h.t;
+    if (job->normals)
+        for (int a = 0; a < 3; a++)
+            job->normals[3 * px + (size_t)a] =
+                h.hit ? (uint8_t)((n[a] * 0.5f + 0.5f) * 255.0f + 0.5f) : 0;
+    if (job->normals_f)
+        for (int a = 0; a < 3; a++)
+            job->normals_f[3 * px + (size_t)a] = h.hit ? n[a] : 0.0f;
+    *hits += (uint64_t)h.hit;
+    *steps += h.steps;
+}
+
+/* The pixels [i0, i1) x [j0, j1): with a beam window, each ray is traced
+ * inside it only, and none at all when the block's pyramid touches no
+ * occupied cell. */
+static void render_block(const frame_job *job, const trace_eye *eye, const double *us, uint32_t us0,
+                         uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1, uint64_t *hits,
+                         uint64_t *steps)
+{
+    const camera *cam = job->cam;
+    double t_lo = 0.0, t_hi = INFINITY;
+    int any = 1;
+    if (job->beam_size) {
+        const beam_block b = beam_block_of(cam, i0, i1, j0, j1);
+        any = beam_window(job->tree, cam, &b, job->beam_depth, &t_lo, &t_hi);
+    }
+    if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
+        render_pixel(job, i0, j0, cam->forward, NULL, hits, steps);
+        const size_t p0 = (size_t)j0 * cam->width + i0;
+        for (uint32_t j = j0; j < j1; j++)
+            for (uint32_t i = i0; i < i1; i++) {
+                const size_t px = (size_t)j * cam->width + i;
+                memcpy(job->rgb + 3 * px, job->rgb + 3 * p0, 3);
+                if (job->depth)
+                    job->depth[px] = INFINITY;
+                if (job->normals)
+                    memset(job->normals + 3 * px, 0, 3);
+                if (job->normals_f)
+                    memset(job->normals_f + 3 * px, 0, 3 * sizeof(float));
+            }
+        return;
+    }
+    for (uint32_t j = j0; j < j1; j++) {
+        const double v = camera_v(cam, j);
+        for (uint32_t i = i0; i < i1; i++) {
+            double dir[3];
+            camera_ray_uv(cam, us[i - us0], v, dir);
+            trace_ray r;
+            const int traced = trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, t_hi);
+            render_pixel(job, i, j, dir, traced ? &r : NULL, hits, steps);
+        }
+    }
+}
+
 static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t *hits,
                         uint64_t *steps)
 {
     const camera *cam = job->cam;
-    const uint32_t w = cam->width;
-    uint32_t i1 = (tx + 1) * FRAME_TILE, j1 = (ty + 1) * FRAME_TILE;
-    if (i1 > cam->width)
-        i1 = cam->width;
-    if (j1 > cam->height)
-        j1 = cam->height;
-    const uint32_t i0 = tx * FRAME_TILE;
-    double us[FRAME_TILE];
+    const uint32_t i0 = tx * FRAME_TILE, j0 = ty * FRAME_TILE;
+    const uint32_t i1 = i0 + FRAME_TILE < cam->width ? i0 + FRAME_TILE : cam->width;
+    const uint32_t j1 = j0 + FRAME_TILE < cam->height ? j0 + FRAME_TILE : cam->height;
+    const uint32_t bs = job->beam_size ? job->beam_size : FRAME_TILE;
+    double us[FRAME_TILE]; /* camera_u of column i0 + k */
     trace_eye eye;
     trace_eye_init(job->tree, cam->eye, &eye); /* eye.ok = 0: every ray misses */
     for (uint32_t i = i0; i < i1; i++)
         us[i - i0] = camera_u(cam, i);
-    for (uint32_t j = ty * FRAME_TILE; j < j1; j++) {
-        const double v = camera_v(cam, j);
-        for (uint32_t i = i0; i < i1; i++) {
-            double dir[3];
-            camera_ray_uv(cam, us[i - i0], v, dir);
-            trace_hit h;
-            trace_ray r;
-            if (trace_setup_eye(&eye, dir, &r)) {
-                trace_ray_prepared(job->tree, &job->opts, &r, &h);
-            } else { /* trace_ray_cast's miss */
-                h.hit = 0;
-                h.t = INFINITY;
-                h.steps = 0;
-            }
-            float rgb[3], n[3];
-            shade_hit(job->tree, &job->shade, &h, dir, rgb, n);
-            size_t px = (size_t)j * w + i;
-            for (int a = 0; a < 3; a++)
-                job->rgb[3 * px + (size_t)a] = srgb8_fast(rgb[a]);
-            if (job->depth)
-                job->depth[px] = h.t > FLT_MAX ? (isinf(h.t) ? INFINITY : FLT_MAX) : (float)h.t;
-            if (job->normals)
-                for (int a = 0; a < 3; a++)
-                    job->normals[3 * px + (size_t)a] =
-                        h.hit ? (uint8_t)((n[a] * 0.5f + 0.5f) * 255.0f + 0.5f) : 0;
-            if (job->normals_f)
-                for (int a = 0; a < 3; a++)
-                    job->normals_f[3 * px + (size_t)a] = h.hit ? n[a] : 0.0f;
-            *hits += (uint64_t)h.hit;
-            *steps += h.steps;
-        }
-    }
+    for (uint32_t bj = j0; bj < j1; bj += bs)
+        for (uint32_t bi = i0; bi < i1; bi += bs)
+            render_block(job, &eye, us, i0, bi, bi + bs < i1 ? bi + bs : i1, bj,
+                         bj + bs < j1 ? bj + bs : j1, hits, steps);
 }
 
 static void work(frame_shared *sh, int caller)

@@ -25,7 +25,7 @@ static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
     "              [--split K] [--refine] [--light X,Y,Z] [--background R,G,B]\n"
-    "              [--threads N] [--trust] [--info] [-q]\n"
+    "              [--beam N] [--threads N] [--trust] [--info] [-q]\n"
     "       render FILE.oct --views VIEWS_FILE [options]\n"
     "       render FILE.oct -o 'frame_%04d.png' --orbit N [options]\n"
     "       render --info FILE.oct\n";
@@ -43,6 +43,8 @@ static const char help_text[] =
     "                      a name ending in .pfm gets float normals (3-channel PFM)\n"
     "  --split K           octree depth where the empty-space skipping stops (default: levels)\n"
     "  --refine            intersect the voxels' stored planes for sub-voxel depth\n"
+    "  --beam N            trace N x N pixel blocks as one pyramid first, to skip what\n"
+    "                      no ray of the block can hit (default 16; 0: off; same image)\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
     "  --background R,G,B  linear colour of rays that miss, 0..1 each (default 0,0,0)\n"
     "  --threads N         worker threads (default: online CPUs)\n"
@@ -151,7 +153,7 @@ int main(int argc, char **argv)
     views_view base;
     views_defaults(&base);
     const char *oct_path = NULL, *views_path = NULL;
-    long orbit = 0, split = -1, threads = 0;
+    long orbit = 0, split = -1, threads = 0, beam = FRAME_BEAM_DEFAULT;
     int refine = 0, info = 0, quiet = 0, trust = 0, status = EXIT_OK;
     double light[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
     int has_light = 0;
@@ -198,7 +200,7 @@ int main(int argc, char **argv)
         int known = views_is_option(a) || strcmp(a, "--views") == 0 ||
                     strcmp(a, "--orbit") == 0 || strcmp(a, "--split") == 0 ||
                     strcmp(a, "--light") == 0 || strcmp(a, "--background") == 0 ||
-                    strcmp(a, "--threads") == 0;
+                    strcmp(a, "--threads") == 0 || strcmp(a, "--beam") == 0;
         if (!known)
             return diag_usage_error(usage_text, "unrecognized option '%s'", a);
         if (!val)
@@ -216,6 +218,8 @@ int main(int argc, char **argv)
             e = parse_long(val, 0, OCT_MAX_LEVELS, &split);
         } else if (strcmp(a, "--threads") == 0) {
             e = parse_long(val, 1, 256, &threads);
+        } else if (strcmp(a, "--beam") == 0) {
+            e = parse_long(val, 0, FRAME_TILE, &beam);
         } else if (strcmp(a, "--light") == 0) {
             e = parse_vec3(val, light);
             has_light = 1;
@@ -396,6 +400,8 @@ int main(int argc, char **argv)
         job.normals = v->normals && !is_pfm(v->normals) ? nrm : NULL;
         job.normals_f = v->normals && is_pfm(v->normals) ? nrm_f : NULL;
         job.threads = (unsigned)threads;
+        job.beam_size = (unsigned)beam;
+        job.beam_depth = frame_beam_depth(tree->levels);
         if (!quiet && diag_stderr_is_tty())
             job.progress = progress_bar;
         frame_stats st;

@@ -128,6 +128,7 @@ int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
     }
     if (!(t_end > 0.0))
         return 0;
+    r->t_start = 0.0;
     r->t_end = t_end;
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
@@ -142,6 +143,16 @@ int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], 
     if (!trace_eye_init(tree, eye, &e))
         return 0;
     return trace_setup_eye(&e, dir, r);
+}
+
+int trace_clip(trace_ray *r, double t_lo, double t_hi)
+{
+    const double lo = t_lo - r->t_base, hi = t_hi - r->t_base;
+    if (lo > r->t_start)
+        r->t_start = lo;
+    if (hi < r->t_end)
+        r->t_end = hi;
+    return r->t_start < r->t_end;
 }
 
 /* --refine in one occupied voxel `idx` (corner v), which the ray occupies
@@ -296,8 +307,8 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     unsigned d = 0, ci = 0;
     uint32_t size = UINT32_C(1) << levels;
     __m128i V = _mm_setzero_si128();
-    __m128d Txy, Tzw, TC = _mm_setzero_pd();
-    double tc = 0.0;
+    double tc = r->t_start;
+    __m128d Txy, Tzw, TC = _mm_set1_pd(tc);
     uint32_t steps = 0;
     int side = 0; /* --refine: see refine_voxel */
 
@@ -494,7 +505,7 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     /* the current cell */
     unsigned d = 0, ci = 0;
     uint32_t vx = 0, vy = 0, vz = 0, size = UINT32_C(1) << levels;
-    double tx, ty, tz, tc = 0.0;
+    double tx, ty, tz, tc = r->t_start;
     uint32_t steps = 0;
     int side = 0; /* --refine: see refine_voxel */
 

@@ -57,7 +57,8 @@ typedef struct trace_ray {
     double inv[3];    /* 1/d per axis; 1 on a zero axis */
     double d[3];      /* direction in grid units per t; 0 on a zero axis */
     double t_base;    /* t of the local start point on the caller's ray */
-    double t_end;     /* local t at which the ray leaves the root cube */
+    double t_start;   /* local t at which the traversal starts: 0, or trace_clip's */
+    double t_end;     /* local t at which the ray leaves the root cube (or trace_clip's) */
     int32_t sgn[3];   /* +1 or -1; +1 on a zero axis */
     uint32_t v[3];    /* zero axis: the voxel the ray stays in (floor(o) clamped to
                          N - 1); 0 on other axes, whose start voxel the
@@ -94,6 +95,14 @@ typedef struct trace_eye {
 
 int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e);
 int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r);
+
+/* Restricts a prepared ray to the caller's t in [t_lo, t_hi]: the traversal
+ * starts in the cell the ray is in at t_lo (chosen by the tie rule, as if it
+ * had walked there) and stops at t_hi. When no occupied voxel meets the ray
+ * outside [t_lo, t_hi] (what beam_window guarantees), the hit, its voxel and
+ * its t are those of the whole ray, bit for bit; only the step count falls.
+ * Returns 0 when nothing of the ray is left (then it must not be traced). */
+int trace_clip(trace_ray *r, double t_lo, double t_hi);
 
 typedef struct trace_opts {
     unsigned split;   /* K: empty cells of depth <= K are skipped whole; 0..L */

@@ -1,5 +1,6 @@
-/* Tests for render/frame: identical bytes whatever the thread count; depth is
- * finite or +inf, never NaN, for degenerate cameras, under FE_INVALID traps. */
+/* Tests for render/frame: identical bytes whatever the thread count and
+ * whether rays are traced whole or in their beam's window; depth is finite or
+ * +inf, never NaN, for degenerate cameras, under FE_INVALID traps. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -46,8 +47,9 @@ static oct_tree *ball(unsigned levels)
     return t;
 }
 
-static void render(const oct_tree *t, const camera *cam, unsigned threads, int refine,
-                   uint8_t *rgb, float *depth, uint8_t *nrm, frame_stats *st)
+static void render_beam(const oct_tree *t, const camera *cam, unsigned threads, int refine,
+                        unsigned beam, uint8_t *rgb, float *depth, uint8_t *nrm,
+                        frame_stats *st)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
@@ -61,7 +63,83 @@ static void render(const oct_tree *t, const camera *cam, unsigned threads, int r
     job.depth = depth;
     job.normals = nrm;
     job.threads = threads;
+    job.beam_size = beam;
+    job.beam_depth = frame_beam_depth(t->levels);
     assert_int_equal(frame_render(&job, st), 0);
+}
+
+static void render(const oct_tree *t, const camera *cam, unsigned threads, int refine,
+                   uint8_t *rgb, float *depth, uint8_t *nrm, frame_stats *st)
+{
+    render_beam(t, cam, threads, refine, FRAME_BEAM_DEFAULT, rgb, depth, nrm, st);
+}
+
+/* A few voxels scattered at random: small targets the beams must not lose. */
+static oct_tree *scattered(unsigned levels, size_t n, uint64_t seed)
+{
+    uint32_t(*xyz)[3] = malloc(n * sizeof *xyz);
+    uint32_t *attr = malloc(n * sizeof *attr);
+    assert_non_null(xyz);
+    assert_non_null(attr);
+    const uint32_t lim = UINT32_C(1) << levels;
+    for (size_t i = 0; i < n; i++) {
+        for (int a = 0; a < 3; a++) {
+            seed = seed * 6364136223846793005u + 1442695040888963407u;
+            xyz[i][a] = (uint32_t)(seed >> 33) % lim;
+        }
+        const double nrm[3] = {(double)(i % 3) - 1.0, 1.0, 0.5};
+        attr[i] = oct_voxel_pack(nrm, 0.25);
+    }
+    const double origin[3] = {-1, -1, -1};
+    oct_tree *t = tree_util_build(levels, origin, 2.0, (const uint32_t(*)[3])xyz, n, attr, NULL,
+                                  1, NULL);
+    free(xyz);
+    free(attr);
+    assert_non_null(t);
+    return t;
+}
+
+/* The beam only skips what no ray can hit: with any block size the image,
+ * depth and normals are those of rays traced whole, byte for byte. Eyes
+ * outside, on a face, inside the cube and inside the surface; wide, narrow
+ * and odd-sized views; tiny isolated targets. */
+static void test_beam_same_image(void **state)
+{
+    (void)state;
+    oct_tree *trees[] = {ball(6), scattered(7, 40, 1), scattered(9, 300, 2)};
+    static const double eyes[][3] = {
+        {2.2, 1.6, 1.9}, {-3, 0.1, 0.2}, {0.1, -1, 0.3}, {0.2, 0.1, -0.3}, {0.7, 0, 0}, {0, 0, 9},
+    };
+    static const double fovs[] = {40, 120, 5, 60, 90, 25};
+    static const unsigned beams[] = {1, 3, 16, 32};
+    const uint32_t w = 67, h = 45;
+    const size_t px = (size_t)w * h;
+    uint8_t *a = malloc(px * 3), *b = malloc(px * 3), *na = malloc(px * 3), *nb = malloc(px * 3);
+    float *da = malloc(px * 4), *db = malloc(px * 4);
+    uint64_t hits = 0;
+    for (size_t ti = 0; ti < sizeof trees / sizeof trees[0]; ti++)
+        for (size_t k = 0; k < sizeof eyes / sizeof eyes[0]; k++) {
+            camera cam;
+            const double target[3] = {0.05, -0.1, 0.02}, up[3] = {0, 0, 1};
+            assert_int_equal(camera_init(&cam, eyes[k], target, up, fovs[k], w, h), CAMERA_OK);
+            for (int refine = 0; refine <= 1; refine++) {
+                frame_stats sa, sb;
+                render_beam(trees[ti], &cam, 2, refine, 0, a, da, na, &sa);
+                hits += sa.hits;
+                for (size_t bi = 0; bi < sizeof beams / sizeof beams[0]; bi++) {
+                    render_beam(trees[ti], &cam, 2, refine, beams[bi], b, db, nb, &sb);
+                    assert_memory_equal(a, b, px * 3);
+                    assert_memory_equal(na, nb, px * 3);
+                    assert_memory_equal(da, db, px * 4);
+                    assert_int_equal(sa.hits, sb.hits);
+                    assert_true(sb.steps <= sa.steps);
+                }
+            }
+        }
+    assert_true(hits > 0);
+    free(a), free(b), free(na), free(nb), free(da), free(db);
+    for (size_t ti = 0; ti < sizeof trees / sizeof trees[0]; ti++)
+        tree_util_free(trees[ti]);
 }
 
 static void test_threads_identical(void **state)
@@ -152,10 +230,88 @@ static void test_srgb_table_exact(void **state)
         assert_int_equal(frame_srgb8(special[k]), image_srgb8(special[k]));
 }
 
+/* Far from the world origin, with an edge that is not a power of two: the
+ * beam must place cells as the traversal does (relative to its eye, in
+ * voxels), or it misplaces them by ulp(origin), more than any fixed margin.
+ * A full layer of voxels seen from just above (origin 1e9 and 1.08e9), and
+ * single voxels under a ray lying exactly on the voxel's face plane x = k,
+ * which the tie rule gives to voxel k. */
+static void test_beam_far_from_origin(void **state)
+{
+    (void)state;
+    const unsigned L = 6;
+    const uint32_t n = 1u << L;
+    uint32_t(*xyz)[3] = malloc((size_t)n * n * sizeof *xyz);
+    uint32_t *attr = malloc((size_t)n * n * sizeof *attr);
+    assert_non_null(xyz);
+    assert_non_null(attr);
+    const double up_n[3] = {0, 0, 1};
+    for (uint32_t k = 0; k < n * n; k++) {
+        xyz[k][0] = k % n;
+        xyz[k][1] = k / n;
+        xyz[k][2] = n / 2;
+        attr[k] = oct_voxel_pack(up_n, 0.3);
+    }
+    const uint32_t w = 61;
+    const size_t px = (size_t)w * w;
+    uint8_t *a = malloc(px * 3), *b = malloc(px * 3);
+    float *da = malloc(px * 4), *db = malloc(px * 4);
+    static const double origins[] = {1e9, 1.08e9};
+    for (size_t oi = 0; oi < 2; oi++)
+        for (int k = 0; k < 4; k++) {
+            const double O = origins[oi], edge = 0.7 * (1.0 + 0.01 * k);
+            const double origin[3] = {O, O, O};
+            oct_tree *t = tree_util_build(L, origin, edge, (const uint32_t(*)[3])xyz, (size_t)n * n,
+                                          attr, NULL, 1, NULL);
+            assert_non_null(t);
+            const double eye[3] = {O + 0.37 * edge, O + 0.41 * edge, O + 0.9 * edge};
+            const double target[3] = {eye[0], eye[1], eye[2] - edge}, up[3] = {0, 1, 0};
+            camera cam;
+            assert_int_equal(camera_init(&cam, eye, target, up, 1.0, w, w), CAMERA_OK);
+            for (int refine = 0; refine <= 1; refine++) {
+                frame_stats sa, sb;
+                render_beam(t, &cam, 1, refine, 0, a, da, NULL, &sa);
+                assert_int_equal(sa.hits, px);
+                render_beam(t, &cam, 1, refine, 16, b, db, NULL, &sb);
+                assert_memory_equal(a, b, px * 3);
+                assert_memory_equal(da, db, px * 4);
+            }
+            tree_util_free(t);
+        }
+    for (uint32_t kk = 1; kk <= 20; kk++) {
+        const double O = 1e9, edge = 64.0 / 3.0, s = edge / 64;
+        const uint32_t k = 3u * kk;
+        const double ex = O + kk;
+        if ((ex - O) * (64 / edge) != (double)k)
+            continue; /* the ray exactly on the plane x = k only */
+        const uint32_t one[1][3] = {{k, 30, 10}};
+        const uint32_t rec = oct_voxel_pack(up_n, 0.0);
+        const double origin[3] = {O, O, O};
+        oct_tree *t = tree_util_build(L, origin, edge, one, 1, &rec, NULL, 1, NULL);
+        assert_non_null(t);
+        const double eye[3] = {ex, O + 30.5 * s, O + 50 * s};
+        const double target[3] = {eye[0], eye[1], eye[2] - edge}, up[3] = {0, 1, 0};
+        camera cam;
+        assert_int_equal(camera_init(&cam, eye, target, up, 0.01, 1, 1), CAMERA_OK);
+        uint8_t c0[3], c1[3];
+        float d0, d1;
+        frame_stats s0, s1;
+        render_beam(t, &cam, 1, 0, 0, c0, &d0, NULL, &s0);
+        assert_int_equal(s0.hits, 1);
+        render_beam(t, &cam, 1, 0, 1, c1, &d1, NULL, &s1);
+        assert_int_equal(s1.hits, 1);
+        assert_true(d0 == d1);
+        tree_util_free(t);
+    }
+    free(a), free(b), free(da), free(db), free(xyz), free(attr);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_beam_same_image),
+        cmocka_unit_test(test_beam_far_from_origin),
         cmocka_unit_test(test_degenerate_cameras_no_nan),
         cmocka_unit_test(test_srgb_table_exact),
     };

@@ -423,6 +423,90 @@ static void test_tree_util_layout(void **state)
     tree_util_free(t);
 }
 
+/* trace_clip: a ray started at any plane time before its hit (or at the
+ * hit's own entry time) meets the same voxel at the same t, bits and all, as
+ * the whole ray: rays full of exact ties (dyadic eyes, direction components
+ * in {0, +-1, +-2}), every split, plain and --refine. */
+static void test_clip_same_hit(void **state)
+{
+    (void)state;
+    unsigned long checked = 0, steps_whole = 0, steps_clipped = 0;
+    for (int tr = 0; tr < 16; tr++) {
+        const unsigned L = 2 + irand(5);
+        const uint32_t N = 1u << L;
+        const size_t n = 1 + irand(N * N / 2 + 1);
+        uint32_t(*xyz)[3] = malloc(n * sizeof *xyz);
+        uint32_t *attr = malloc(n * sizeof *attr);
+        assert_non_null(xyz);
+        assert_non_null(attr);
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++) {
+            uint32_t v[3] = {irand(N), irand(N), irand(N)};
+            int dup = 0;
+            for (size_t j = 0; j < m && !dup; j++)
+                dup = !memcmp(xyz[j], v, sizeof v);
+            if (dup)
+                continue;
+            memcpy(xyz[m], v, sizeof v);
+            const double nr[3] = {(double)irand(5) - 2.0, (double)irand(5) - 2.0, 1.0};
+            attr[m++] = oct_voxel_pack(nr, ((double)irand(200) - 100.0) / 128.0);
+        }
+        const double origin[3] = {0, 0, 0};
+        oct_tree *t = tree_util_build(L, origin, (double)N, (const uint32_t(*)[3])xyz, m, attr, NULL,
+                                      1, NULL);
+        assert_non_null(t);
+        for (int ray = 0; ray < 160; ray++) {
+            double eye[3], dir[3];
+            for (int a = 0; a < 3; a++) {
+                eye[a] = (double)irand(4 * (N + 4)) / 4.0 - 2.0;
+                dir[a] = (double)irand(5) - 2.0;
+            }
+            trace_ray r0;
+            if (!trace_setup(t, eye, dir, &r0))
+                continue;
+            trace_opts plain = {L, 0};
+            trace_hit hp;
+            if (!trace_ray_prepared(t, &plain, &r0, &hp))
+                continue;
+            double starts[3 * 65 + 1];
+            int ns = 0;
+            for (int a = 0; a < 3; a++)
+                for (uint32_t k = 0; k <= N && (r0.active >> a & 1); k++) {
+                    const double tl = trace_plane_time(&r0, a, (double)k);
+                    if (tl >= 0.0 && r0.t_base + tl <= hp.t)
+                        starts[ns++] = r0.t_base + tl;
+                }
+            starts[ns++] = hp.t;
+            for (unsigned K = 0; K <= L; K++)
+                for (int refine = 0; refine <= 1; refine++) {
+                    const trace_opts op = {K, refine};
+                    trace_hit h0;
+                    trace_ray_prepared(t, &op, &r0, &h0);
+                    for (int c = 0; c < ns; c++) {
+                        trace_ray r = r0;
+                        assert_true(trace_clip(&r, starts[c], INFINITY));
+                        trace_hit h1;
+                        trace_ray_prepared(t, &op, &r, &h1);
+                        assert_int_equal(h1.hit, h0.hit);
+                        assert_true(h1.voxel == h0.voxel);
+                        assert_true(h1.t == h0.t);
+                        assert_true(h1.steps <= h0.steps);
+                        steps_whole += h0.steps;
+                        steps_clipped += h1.steps;
+                        checked++;
+                    }
+                }
+        }
+        tree_util_free(t);
+        free(xyz);
+        free(attr);
+    }
+    print_message("clip: %lu clipped traversals, all the same hit; %lu steps against %lu whole\n",
+                  checked, steps_clipped, steps_whole);
+    assert_true(checked > 5000);
+    assert_true(steps_clipped < steps_whole * 3 / 4); /* they do start later */
+}
+
 int main(void)
 {
     /* TEST_SEED=N replays another deterministic stream of rays and trees */
@@ -434,6 +518,7 @@ int main(void)
         cmocka_unit_test(test_empty_tree_and_degenerate_rays),
         cmocka_unit_test(test_random_trees_vs_oracle),
         cmocka_unit_test(test_deep_single_path),
+        cmocka_unit_test(test_clip_same_hit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -29,6 +29,19 @@ awk -v t="$t" 'BEGIN { exit !(t > 2.2 - 1/128 && t <= 2.2 + 1e-6) }' || fail "ce
 "$BIN/render" "$T/s.oct" -o "$T/t3.png" --size 64x48 $view --depth "$T/t3.pfm" --threads 3 -q
 cmp -s "$T/t1.png" "$T/t3.png" && cmp -s "$T/t1.pfm" "$T/t3.pfm" || fail "thread count changed the image"
 
+# The beam test only skips what no ray can hit: the same bytes with it off,
+# at the default and at odd block sizes, plain and refined.
+for flags in "" "--refine"; do
+    "$BIN/render" "$T/s.oct" -o "$T/b0.png" --size 71x53 $view --depth "$T/b0.pfm" --beam 0 $flags -q
+    for b in 16 5 32; do
+        "$BIN/render" "$T/s.oct" -o "$T/b.png" --size 71x53 $view --depth "$T/b.pfm" --beam $b $flags -q
+        cmp -s "$T/b0.png" "$T/b.png" && cmp -s "$T/b0.pfm" "$T/b.pfm" || fail "--beam $b $flags changed the image"
+    done
+done
+expect_exit 2 "$BIN/render" "$T/s.oct" -o "$T/x.png" --beam 33
+expect_err "--beam: '33'"
+[ ! -e "$T/x.png" ] || fail "--beam 33 wrote a file"
+
 # A views file renders every line from one mapping.
 printf '# two views\n-o %s/v1.png --size 16x16\n\n-o %s/v2.png --eye 0.5,-3,0.5 --depth %s/v2.pfm\n' \
     "$T" "$T" "$T" > "$T/v.views"
