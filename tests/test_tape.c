@@ -479,7 +479,8 @@ static void check_lanes(const tape *t, const double pts[][3], unsigned n, const 
 {
     static tape_dual_lanes lslots[MAXSLOTS];
     static tape_dual duals[MAXSLOTS];
-    double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+    double x[TAPE_LANES] = {0}, y[TAPE_LANES] = {0}, z[TAPE_LANES] = {0}; /* lanes past n: unread */
+    double f[TAPE_LANES], g[3][TAPE_LANES];
     for (unsigned l = 0; l < n; l++) {
         x[l] = pts[l][0];
         y[l] = pts[l][1];
