@@ -173,20 +173,25 @@ static void worker_free(worker *wk)
 /* --- cell tests ----------------------------------------------------------- */
 
 /* World box of a cell, rounded outward and clipped to bounds. 0 if empty. */
+/* Axis k of the cell with integer coordinate ck at depth: its span rounded
+ * outward and clipped to the bounds. 0 when it lies beyond them. */
+static int cell_span(const build_ctx *c, unsigned depth, uint64_t ck, int k, interval *span)
+{
+    double h = c->cell_edge[depth];
+    span->lo = interval_next_down(c->origin[k] + (double)ck * h);
+    span->hi = interval_next_up(c->origin[k] + (double)(ck + 1) * h);
+    if (span->hi > c->bmax[k])
+        span->hi = c->bmax[k];
+    return span->lo <= span->hi;
+}
+
 static int cell_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], interval box[3],
                     double centre[3])
 {
-    double h = c->cell_edge[depth];
     for (int k = 0; k < 3; k++) {
-        double lo = interval_next_down(c->origin[k] + (double)cell[k] * h);
-        double hi = interval_next_up(c->origin[k] + (double)(cell[k] + 1) * h);
-        if (hi > c->bmax[k])
-            hi = c->bmax[k];
-        if (lo > hi)
+        if (!cell_span(c, depth, cell[k], k, &box[k]))
             return 0;
-        box[k].lo = lo;
-        box[k].hi = hi;
-        centre[k] = 0.5 * (lo + hi);
+        centre[k] = 0.5 * (box[k].lo + box[k].hi);
     }
     return 1;
 }
@@ -535,7 +540,7 @@ static int child_enclosures(worker *wk, const tape *t, const interval pbox[3], c
 }
 
 /* The boxes of a node's children, made lazily: a child's box is its lower
- * or upper half on each axis, each half rounded as cell_box rounds it. */
+ * or upper half on each axis, each half a cell_span. */
 typedef struct child_boxes {
     interval half[3][2];
     double mid[3][2];
@@ -548,18 +553,11 @@ typedef struct child_boxes {
 static void child_boxes_init(const build_ctx *c, unsigned depth, const uint64_t cell[3],
                              child_boxes *cb)
 {
-    double h = c->cell_edge[depth + 1];
     for (int k = 0; k < 3; k++)
         for (unsigned b = 0; b < 2; b++) {
-            uint64_t ck = 2 * cell[k] + b;
-            double lo = interval_next_down(c->origin[k] + (double)ck * h);
-            double hi = interval_next_up(c->origin[k] + (double)(ck + 1) * h);
-            if (hi > c->bmax[k])
-                hi = c->bmax[k];
-            cb->half_ok[k][b] = lo <= hi;
-            cb->half[k][b].lo = lo;
-            cb->half[k][b].hi = hi;
-            cb->mid[k][b] = 0.5 * (lo + hi);
+            interval *span = &cb->half[k][b];
+            cb->half_ok[k][b] = (uint8_t)cell_span(c, depth + 1, 2 * cell[k] + b, k, span);
+            cb->mid[k][b] = 0.5 * (span->lo + span->hi);
         }
     memset(cb->have, -1, sizeof cb->have);
 }
