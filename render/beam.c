@@ -116,15 +116,15 @@ static double beam_extreme(const beam_walk *bw, int far)
 static double t_down(double dist, double scale) { return dist / scale * (1.0 - 0x1p-40); }
 static double t_up(double dist, double scale) { return dist / scale * (1.0 + 0x1p-40); }
 
-int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, unsigned depth,
-                double *t_lo, double *t_hi)
+int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, double *t_lo,
+                double *t_hi)
 {
     const unsigned levels = tree->levels;
     if (tree->node_count[0] == 0 || levels < 1 || levels > OCT_MAX_LEVELS)
         return 0;
     beam_walk bw;
     bw.tree = tree;
-    bw.lim = depth < 1 ? 1 : depth > levels ? levels : depth;
+    bw.lim = levels;
     pyramid_init(&bw.p, cam, b);
     /* Grid units, the eye placed as the traversal places it: cell centres
      * are exact and, relative to the eye, carry one rounding of

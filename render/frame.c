@@ -113,7 +113,7 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
     int any = 1;
     if (job->beam_size) {
         const beam_block b = beam_block_of(cam, i0, i1, j0, j1);
-        any = beam_window(job->tree, cam, &b, job->beam_depth, &t_lo, &t_hi);
+        any = beam_window(job->tree, cam, &b, &t_lo, &t_hi);
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
         render_pixel(job, i0, j0, cam->forward, NULL, hits, steps);

@@ -15,11 +15,6 @@
 #define FRAME_TILE 32 /* pixels a tile side */
 #define FRAME_BEAM_DEFAULT 16 /* beam block side: the fewest instructions measured (RENDER.md) */
 
-/* Depth of the cells the beam test looks at: the voxels themselves. The
- * best-first walk stays cheap there and the tightest window pays most
- * (RENDER.md, "Beam": levels - 1 and - 2 cost more instructions). */
-static inline unsigned frame_beam_depth(unsigned levels) { return levels; }
-
 typedef struct frame_job {
     const oct_tree *tree;
     const camera *cam;
@@ -32,7 +27,6 @@ typedef struct frame_job {
     unsigned threads;   /* >= 1 */
     unsigned beam_size; /* pixel block side of the beam test (beam.h), 1..FRAME_TILE;
                            0: every ray traced whole */
-    unsigned beam_depth;/* depth of the octree cells the beam test looks at */
     /* Called by the calling thread after each tile it finishes, with tiles
      * done so far and the total; may be NULL. */
     void (*progress)(void *ctx, uint64_t done, uint64_t total);

@@ -401,7 +401,6 @@ int main(int argc, char **argv)
         job.normals_f = v->normals && is_pfm(v->normals) ? nrm_f : NULL;
         job.threads = (unsigned)threads;
         job.beam_size = (unsigned)beam;
-        job.beam_depth = frame_beam_depth(tree->levels);
         if (!quiet && diag_stderr_is_tty())
             job.progress = progress_bar;
         frame_stats st;

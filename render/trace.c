@@ -345,15 +345,14 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             memcpy(&masks, gr->mask, 8);
             Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
             Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
-        } else if (d > split && d < levels) {
-            /* step two, below K: walk the empty cell voxel by voxel */
-            steps = trace_walk_empty(V, size, TC, Txy, Tzw, ZOxy, ZOzw, ZIxy, ZIzw, zo[2], zi[2], far,
-                                     steps, max_steps);
-            if (steps > max_steps)
-                goto out;
-            side = 0;
-            goto step;
         } else {
+            if (d > split && d < levels) {
+                /* step two, below K: walk the empty cell voxel by voxel */
+                steps = trace_walk_empty(V, size, TC, Txy, Tzw, ZOxy, ZOzw, ZIxy, ZIzw, zo[2], zi[2],
+                                         far, steps, max_steps);
+                if (steps > max_steps)
+                    goto out;
+            }
             side = 0;
             goto step;
         }

@@ -64,7 +64,6 @@ static void render_beam(const oct_tree *t, const camera *cam, unsigned threads, 
     job.normals = nrm;
     job.threads = threads;
     job.beam_size = beam;
-    job.beam_depth = frame_beam_depth(t->levels);
     assert_int_equal(frame_render(&job, st), 0);
 }
 
