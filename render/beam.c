@@ -57,16 +57,16 @@ typedef struct beam_walk {
     pyramid p;
     double o[3];   /* the eye in grid units (voxels), as the traversal has it */
     double margin; /* voxels added to every half edge */
-    unsigned lim, flip;
+    unsigned flip;
 } beam_walk;
 
 /* The nearest (far = 0) or farthest (far = 1) distance from the eye to an
- * occupied cell of depth lim the pyramid may touch; +inf (far: -inf) when
+ * occupied cell of depth lim (1..levels) the pyramid may touch; +inf (far: -inf) when
  * there is none. Children are visited nearest first for the nearest and
  * farthest first for the farthest, and a cell that cannot beat the best so
  * far is not opened: a best-first search along the front (or back) of the
  * surface, not a sweep of the pyramid. */
-static double beam_extreme(const beam_walk *bw, int far)
+static double beam_extreme(const beam_walk *bw, int far, unsigned lim)
 {
     const oct_tree *tree = bw->tree;
     const double *o = bw->o;
@@ -100,7 +100,7 @@ static double beam_extreme(const beam_walk *bw, int far)
                 continue; /* nothing inside can beat the best */
             if (!pyramid_may_touch(&bw->p, ctr, h))
                 continue;
-            if (it.depth + 1 == bw->lim) {
+            if (it.depth + 1 == lim) {
                 best = dist;
                 continue;
             }
@@ -124,7 +124,6 @@ int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, do
         return 0;
     beam_walk bw;
     bw.tree = tree;
-    bw.lim = levels;
     pyramid_init(&bw.p, cam, b);
     /* Grid units, the eye placed as the traversal places it: cell centres
      * are exact and, relative to the eye, carry one rounding of
@@ -141,10 +140,13 @@ int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, do
         bw.flip |= (cam->forward[i] < 0.0 ? 1u : 0u) << i;
     }
     bw.margin = 0x1p-12 + big * 0x1p-40;
-    const double lo = beam_extreme(&bw, 0);
+    const double lo = beam_extreme(&bw, 0, levels);
     if (!(lo < INFINITY))
         return 0;
     *t_lo = t_down(lo, scale);
-    *t_hi = t_up(beam_extreme(&bw, 1), scale);
+    /* The far end only stops rays that miss: the voxels' parents of depth
+     * L - 3 bound it a few voxels later for far fewer opened cells
+     * (RENDER.md, "Beam"). */
+    *t_hi = t_up(beam_extreme(&bw, 1, levels > 3 ? levels - 3 : 1), scale);
     return 1;
 }

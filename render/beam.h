@@ -34,9 +34,9 @@ beam_block beam_block_of(const camera *cam, uint32_t i0, uint32_t i1, uint32_t j
 
 /* Sets *t_lo <= *t_hi (caller's t along unit rays from cam->eye) and returns
  * 1, or returns 0 when no ray of the block can meet an occupied voxel.
- * Occupied cells are looked at down to the voxels themselves: the walk stays
- * cheap there and the tightest window pays most (RENDER.md, "Beam"). Reads
- * the tree only; no allocation. */
+ * t_lo comes from the voxels themselves (the tightest start pays most), t_hi
+ * from their ancestors of depth L - 3 (RENDER.md, "Beam"). Reads the tree
+ * only; no allocation. */
 int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, double *t_lo,
                 double *t_hi);
 
