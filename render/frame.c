@@ -117,18 +117,22 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
         render_pixel(job, i0, j0, cam->forward, NULL, hits, steps);
-        const size_t p0 = (size_t)j0 * cam->width + i0;
-        for (uint32_t j = j0; j < j1; j++)
-            for (uint32_t i = i0; i < i1; i++) {
-                const size_t px = (size_t)j * cam->width + i;
-                memcpy(job->rgb + 3 * px, job->rgb + 3 * p0, 3);
-                if (job->depth)
-                    job->depth[px] = INFINITY;
-                if (job->normals)
-                    memset(job->normals + 3 * px, 0, 3);
-                if (job->normals_f)
-                    memset(job->normals_f + 3 * px, 0, 3 * sizeof(float));
-            }
+        const size_t p0 = (size_t)j0 * cam->width + i0, w = i1 - i0;
+        uint8_t *row0 = job->rgb + 3 * p0;
+        for (size_t k = 1; k < w; k++)
+            memcpy(row0 + 3 * k, row0, 3);
+        for (uint32_t j = j0; j < j1; j++) {
+            const size_t px = (size_t)j * cam->width + i0;
+            if (j > j0)
+                memcpy(job->rgb + 3 * px, row0, 3 * w);
+            if (job->depth)
+                for (size_t k = 0; k < w; k++)
+                    job->depth[px + k] = INFINITY;
+            if (job->normals)
+                memset(job->normals + 3 * px, 0, 3 * w);
+            if (job->normals_f)
+                memset(job->normals_f + 3 * px, 0, 3 * w * sizeof(float));
+        }
         return;
     }
     for (uint32_t j = j0; j < j1; j++) {
