@@ -1,6 +1,7 @@
 /* trace: two-step discrete ray traversal of an oct_tree (see trace.h). */
 #include "render/trace.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -34,6 +35,8 @@ int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e)
     e->nvox = UINT32_C(1) << tree->levels;
     e->n = (double)e->nvox;
     e->scale = e->n / tree->edge;
+    if (!(e->scale > 0.0 && e->scale <= DBL_MAX)) /* trace_setup_eye relies on it */
+        return 0;
     for (int a = 0; a < 3; a++) {
         if (!isfinite(eye[a]))
             return 0;
@@ -54,17 +57,20 @@ int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
         return 0;
     const double n = e->n, scale = e->scale;
     const double *o = e->o;
+    /* scale is finite and > 0, so d is finite exactly when dir is and the
+     * product does not overflow; 1/d is finite exactly when d is neither 0
+     * nor so small that the reciprocal overflows */
     double d[3];
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++)
+        d[a] = dir[a] * scale;
+    if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
+        return 0;
     unsigned active = 0;
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        if (!isfinite(dir[a]))
-            return 0;
-        d[a] = dir[a] * scale;
-        if (!isfinite(d[a]))
-            return 0;
         const double inv = 1.0 / d[a];
-        const int act = d[a] != 0.0 && isfinite(inv);
+        const int act = fabs(inv) <= DBL_MAX;
         active |= (unsigned)act << a;
         r->inv[a] = act ? inv : 1.0;
         r->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
