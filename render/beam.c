@@ -50,6 +50,7 @@ typedef struct beam_item {
     uint64_t node;  /* index in its depth */
     uint32_t cell[3];
     unsigned depth;
+    double dist;    /* its distance bound when it was pushed */
 } beam_item;
 
 typedef struct beam_walk {
@@ -73,10 +74,12 @@ static double beam_extreme(const beam_walk *bw, int far, unsigned lim)
     double best = far ? -INFINITY : INFINITY;
     beam_item stack[8 * OCT_MAX_LEVELS + 1];
     unsigned sp = 0;
-    stack[sp++] = (beam_item){0, {0, 0, 0}, 0};
+    stack[sp++] = (beam_item){0, {0, 0, 0}, 0, 0.0};
     const unsigned order = bw->flip ^ (far ? 7u : 0u);
     while (sp) {
         const beam_item it = stack[--sp];
+        if (far ? it.dist <= best : it.dist >= best)
+            continue; /* the best improved since it was pushed */
         const oct_group *g = &tree->groups[it.depth][it.node >> 3];
         const unsigned mask = g->mask[it.node & 7u];
         const double s = (double)(UINT32_C(1) << (tree->levels - it.depth - 1)); /* child edge */
@@ -105,7 +108,7 @@ static double beam_extreme(const beam_walk *bw, int far, unsigned lim)
                 continue;
             }
             stack[sp++] = (beam_item){oct_child_index(tree->groups[it.depth], it.node, c),
-                                      {cell[0], cell[1], cell[2]}, it.depth + 1};
+                                      {cell[0], cell[1], cell[2]}, it.depth + 1, dist};
         }
     }
     return best;
