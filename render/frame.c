@@ -21,9 +21,14 @@ typedef struct frame_shared {
 /* image_srgb8 without pow: the code value is the number of thresholds at or
  * below the input, where threshold k is the least float whose image_srgb8
  * is >= k (found by bisection over the float bit patterns, image_srgb8 being
- * monotone). Bit for bit image_srgb8, NaN and out-of-range inputs included;
- * tests/test_frame.c compares the two over every float in [0, 1]. */
-static float srgb_threshold[256];
+ * monotone). The count starts at the code of the input's bucket [i, i + 1) /
+ * 4096 (i / 4096 is exact, so that code is a lower bound) and steps past
+ * the one or two thresholds inside the bucket. Bit for bit image_srgb8, NaN
+ * and out-of-range inputs included; tests/test_frame.c compares the two
+ * over every float in [0, 1]. */
+static float srgb_threshold[257]; /* [256] = NaN ends the count */
+#define SRGB_BUCKETS 4096
+static uint8_t srgb_bucket[SRGB_BUCKETS + 1];
 static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
 
 static float float_of_bits(uint32_t b)
@@ -47,27 +52,25 @@ static void srgb_init(void)
         }
         srgb_threshold[k] = float_of_bits(lo);
     }
+    srgb_threshold[256] = NAN; /* no x is >= it, +inf included */
+    for (unsigned i = 0; i <= SRGB_BUCKETS; i++)
+        srgb_bucket[i] = image_srgb8((float)i / SRGB_BUCKETS);
+}
+
+static inline uint8_t srgb8_fast(float x)
+{
+    if (!(x > 0.0f)) /* misses on a black background, NaN */
+        return 0;
+    unsigned k = srgb_bucket[x < 1.0f ? (unsigned)(x * SRGB_BUCKETS) : SRGB_BUCKETS];
+    while (x >= srgb_threshold[k + 1])
+        k++;
+    return (uint8_t)k;
 }
 
 uint8_t frame_srgb8(float x)
 {
     pthread_once(&srgb_once, srgb_init);
-    unsigned k = 0;
-    for (unsigned step = 128; step; step >>= 1)
-        if (x >= srgb_threshold[k + step])
-            k += step;
-    return (uint8_t)k;
-}
-
-static inline uint8_t srgb8_fast(float x)
-{
-    if (!(x > 0.0f)) /* misses on a black background: no search */
-        return 0;
-    unsigned k = 0;
-#pragma GCC unroll 8
-    for (unsigned step = 128; step; step >>= 1)
-        k += x >= srgb_threshold[k + step] ? step : 0;
-    return (uint8_t)k;
+    return srgb8_fast(x);
 }
 
 /* Traces, shades and stores pixel (i, j); r is its prepared ray, or NULL

@@ -41,8 +41,8 @@ typedef struct frame_stats {
  * frame is then rendered by the threads that did start). */
 int frame_render(const frame_job *job, frame_stats *stats);
 
-/* image_srgb8(x), bit for bit, by a table of the 255 thresholds (no pow):
- * what frame_render writes. Thread-safe. */
+/* image_srgb8(x), bit for bit, by tables of buckets and thresholds (no
+ * pow): what frame_render writes. Thread-safe. */
 uint8_t frame_srgb8(float x);
 
 #endif
