@@ -1,9 +1,16 @@
-/* beam: the window of ray parameter a pixel block needs (see beam.h). */
+/* beam: the windows of ray parameter a pixel block's rays need (see beam.h). */
 #include "render/beam.h"
 
 #include <math.h>
 
-beam_block beam_block_of(const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+_Static_assert(BEAM_GRID * BEAM_GRID <= 32, "sub-block sets are 32-bit masks");
+
+typedef struct beam_block {
+    double u0, u1, v0, v1; /* camera_u / camera_v of the block's extreme pixel centres */
+} beam_block;
+
+static beam_block beam_block_of(const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
+                                uint32_t j1)
 {
     /* u grows with i, v falls with j */
     beam_block b = {camera_u(cam, i0), camera_u(cam, i1 - 1), camera_v(cam, j1 - 1),
@@ -51,6 +58,7 @@ typedef struct beam_item {
     uint32_t cell[3];
     unsigned depth;
     double dist;    /* its distance bound when it was pushed */
+    uint32_t grid;  /* the sub-blocks it may touch (bit r * BEAM_GRID + c) */
 } beam_item;
 
 typedef struct beam_walk {
@@ -59,27 +67,84 @@ typedef struct beam_walk {
     double o[3];   /* the eye in grid units (voxels), as the traversal has it */
     double margin; /* voxels added to every half edge */
     unsigned flip;
+    /* the sub-blocks' inner boundaries, planes through the eye: column k
+     * (1..cols-1) u = ub_k as R - ub_k F, row k v = vb_k as U - vb_k F,
+     * with the sums of their absolute components */
+    unsigned cols, rows;
+    double col_a[BEAM_GRID][3], col_m[BEAM_GRID], row_a[BEAM_GRID][3], row_m[BEAM_GRID];
 } beam_walk;
 
-/* The nearest (far = 0) or farthest (far = 1) distance from the eye to an
- * occupied cell of depth lim (1..levels) the pyramid may touch; +inf (far: -inf) when
- * there is none. Children are visited nearest first for the nearest and
- * farthest first for the farthest, and a cell that cannot beat the best so
- * far is not opened: a best-first search along the front (or back) of the
- * surface, not a sweep of the pyramid. */
-static double beam_extreme(const beam_walk *bw, int far, unsigned lim)
+/* The sub-blocks (bit r * BEAM_GRID + c) whose pyramids the box (centre c
+ * relative to the eye, half edge h) may touch, assuming it may touch the
+ * block's. u grows with the column; v falls with the row. */
+static uint32_t grid_touch(const beam_walk *bw, const double c[3], double h)
+{
+    unsigned cm = 0, rm = 0, right = 1, above = 1;
+    for (unsigned k = 0; k < bw->cols; k++) {
+        unsigned left = 1, next_right = 1; /* may lie left / right of boundary k + 1 */
+        if (k + 1 < bw->cols) {
+            const double *a = bw->col_a[k + 1];
+            const double sd = a[0] * c[0] + a[1] * c[1] + a[2] * c[2], e = h * bw->col_m[k + 1];
+            left = sd - e <= 0.0;
+            next_right = sd + e >= 0.0;
+        }
+        cm |= (right & left) << k;
+        right = next_right;
+    }
+    for (unsigned k = 0; k < bw->rows; k++) {
+        unsigned below = 1, next_above = 1; /* may lie below / above boundary k + 1 */
+        if (k + 1 < bw->rows) {
+            const double *a = bw->row_a[k + 1];
+            const double sd = a[0] * c[0] + a[1] * c[1] + a[2] * c[2], e = h * bw->row_m[k + 1];
+            next_above = sd + e >= 0.0;
+            below = sd - e <= 0.0;
+        }
+        /* row k lies above boundary k + 1 and below boundary k */
+        rm |= (above & next_above) << k;
+        above = below;
+    }
+    uint32_t m = 0;
+    for (unsigned r = 0; r < bw->rows; r++)
+        if (rm >> r & 1u)
+            m |= cm << (r * BEAM_GRID);
+    return m;
+}
+
+/* The bound a cell must beat to be worth opening for the sub-blocks in m:
+ * the largest of their nearest distances so far (a nearer cell improves at
+ * least one of them), or the smallest of their farthest. -inf / +inf for
+ * none. */
+static double grid_bound(const double *best, uint32_t m, int far)
+{
+    double b = far ? INFINITY : -INFINITY;
+    for (; m; m &= m - 1u) {
+        const double x = best[__builtin_ctz(m)];
+        b = far ? (x < b ? x : b) : (x > b ? x : b);
+    }
+    return b;
+}
+
+/* For every sub-block in `all`, the nearest (far = 0) or farthest (far = 1)
+ * distance from the eye to an occupied cell of depth lim (1..levels) its
+ * pyramid may touch, into best[] (set to +inf, or -inf, beforehand). One
+ * walk serves them all: children nearest first for the nearest (farthest
+ * first for the farthest), and a cell is opened only while it may touch
+ * some sub-block whose distance it could still beat: a best-first search
+ * along the front (or back) of the surface, not a sweep of the pyramid, with
+ * the way down to the surface shared and only the last levels parting. */
+static void beam_extremes(const beam_walk *bw, int far, unsigned lim, uint32_t all, double *best)
 {
     const oct_tree *tree = bw->tree;
     const double *o = bw->o;
-    double best = far ? -INFINITY : INFINITY;
     beam_item stack[8 * OCT_MAX_LEVELS + 1];
     unsigned sp = 0;
-    stack[sp++] = (beam_item){0, {0, 0, 0}, 0, 0.0};
+    stack[sp++] = (beam_item){0, {0, 0, 0}, 0, far ? INFINITY : 0.0, all};
     const unsigned order = bw->flip ^ (far ? 7u : 0u);
     while (sp) {
         const beam_item it = stack[--sp];
-        if (far ? it.dist <= best : it.dist >= best)
-            continue; /* the best improved since it was pushed */
+        const double it_bound = grid_bound(best, it.grid, far);
+        if (far ? it.dist <= it_bound : it.dist >= it_bound)
+            continue; /* the distances improved since it was pushed */
         const oct_group *g = &tree->groups[it.depth][it.node >> 3];
         const unsigned mask = g->mask[it.node & 7u];
         const double s = (double)(UINT32_C(1) << (tree->levels - it.depth - 1)); /* child edge */
@@ -99,19 +164,27 @@ static double beam_extreme(const beam_walk *bw, int far, unsigned lim)
                     d2 += e * e;
             }
             const double dist = sqrt(d2);
-            if (far ? dist <= best : dist >= best)
-                continue; /* nothing inside can beat the best */
-            if (!pyramid_may_touch(&bw->p, ctr, h))
+            if ((far ? dist <= it_bound : dist >= it_bound) || !pyramid_may_touch(&bw->p, ctr, h))
                 continue;
+            const uint32_t touch = it.grid == 1u ? 1u : it.grid & grid_touch(bw, ctr, h);
+            if (!touch)
+                continue;
+            if (touch != it.grid) {
+                const double bound = grid_bound(best, touch, far);
+                if (far ? dist <= bound : dist >= bound)
+                    continue;
+            }
             if (it.depth + 1 == lim) {
-                best = dist;
+                for (uint32_t m = touch; m; m &= m - 1u) {
+                    double *b = &best[__builtin_ctz(m)];
+                    *b = (far ? dist > *b : dist < *b) ? dist : *b;
+                }
                 continue;
             }
             stack[sp++] = (beam_item){oct_child_index(tree->groups[it.depth], it.node, c),
-                                      {cell[0], cell[1], cell[2]}, it.depth + 1, dist};
+                                      {cell[0], cell[1], cell[2]}, it.depth + 1, dist, touch};
         }
     }
-    return best;
 }
 
 /* Grid distance -> the caller's t (unit directions), widened outward by a
@@ -119,15 +192,49 @@ static double beam_extreme(const beam_walk *bw, int far, unsigned lim)
 static double t_down(double dist, double scale) { return dist / scale * (1.0 - 0x1p-40); }
 static double t_up(double dist, double scale) { return dist / scale * (1.0 + 0x1p-40); }
 
-int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, double *t_lo,
-                double *t_hi)
+/* Sub-block boundaries: `n` near-equal parts of [a, b). */
+static unsigned grid_split(uint32_t a, uint32_t b, uint32_t *at)
+{
+    const uint32_t w = b - a;
+    const unsigned n = w < BEAM_GRID ? (unsigned)w : BEAM_GRID;
+    for (unsigned k = 0; k <= n; k++)
+        at[k] = a + (uint32_t)((uint64_t)w * k / n);
+    return n;
+}
+
+int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
+                 uint32_t j1, beam_grid *grid)
 {
     const unsigned levels = tree->levels;
+    grid->cols = grid_split(i0, i1, grid->col);
+    grid->rows = grid_split(j0, j1, grid->row);
     if (tree->node_count[0] == 0 || levels < 1 || levels > OCT_MAX_LEVELS)
         return 0;
     beam_walk bw;
     bw.tree = tree;
-    pyramid_init(&bw.p, cam, b);
+    const beam_block b = beam_block_of(cam, i0, i1, j0, j1);
+    pyramid_init(&bw.p, cam, &b);
+    /* Boundaries halfway between the pixel centres either side: no ray lies
+     * on one. */
+    const double *F = cam->forward, *R = cam->right, *U = cam->up;
+    bw.cols = grid->cols;
+    bw.rows = grid->rows;
+    for (unsigned k = 1; k < bw.cols; k++) {
+        const double ub = 0.5 * (camera_u(cam, grid->col[k] - 1) + camera_u(cam, grid->col[k]));
+        bw.col_m[k] = 0.0;
+        for (int i = 0; i < 3; i++) {
+            bw.col_a[k][i] = R[i] - ub * F[i];
+            bw.col_m[k] += fabs(bw.col_a[k][i]);
+        }
+    }
+    for (unsigned k = 1; k < bw.rows; k++) {
+        const double vb = 0.5 * (camera_v(cam, grid->row[k] - 1) + camera_v(cam, grid->row[k]));
+        bw.row_m[k] = 0.0;
+        for (int i = 0; i < 3; i++) {
+            bw.row_a[k][i] = U[i] - vb * F[i];
+            bw.row_m[k] += fabs(bw.row_a[k][i]);
+        }
+    }
     /* Grid units, the eye placed as the traversal places it: cell centres
      * are exact and, relative to the eye, carry one rounding of
      * ulp(max(|o|, N)), as the traversal's plane times do. The margin covers
@@ -143,13 +250,27 @@ int beam_window(const oct_tree *tree, const camera *cam, const beam_block *b, do
         bw.flip |= (cam->forward[i] < 0.0 ? 1u : 0u) << i;
     }
     bw.margin = 0x1p-12 + big * 0x1p-40;
-    const double lo = beam_extreme(&bw, 0, levels);
-    if (!(lo < INFINITY))
+    double best[BEAM_GRID * BEAM_GRID];
+    uint32_t all = 0;
+    for (unsigned r = 0; r < bw.rows; r++)
+        all |= ((1u << bw.cols) - 1u) << (r * BEAM_GRID);
+    for (unsigned k = 0; k < BEAM_GRID * BEAM_GRID; k++)
+        best[k] = INFINITY;
+    beam_extremes(&bw, 0, levels, all, best);
+    int any = 0;
+    for (unsigned r = 0; r < bw.rows; r++)
+        for (unsigned c = 0; c < bw.cols; c++) {
+            const double lo = best[r * BEAM_GRID + c];
+            grid->t_lo[r][c] = lo < INFINITY ? t_down(lo, scale) : INFINITY;
+            any |= lo < INFINITY;
+        }
+    if (!any)
         return 0;
-    *t_lo = t_down(lo, scale);
-    /* The far end only stops rays that miss: the voxels' parents of depth
-     * L - 3 bound it a few voxels later for far fewer opened cells
-     * (RENDER.md, "Beam"). */
-    *t_hi = t_up(beam_extreme(&bw, 1, levels > 3 ? levels - 3 : 1), scale);
+    /* The far end, for the whole block, only stops rays that miss: the
+     * voxels' parents of depth L - 3 bound it a few voxels later for far
+     * fewer opened cells (RENDER.md, "Beam"). */
+    double hi = -INFINITY;
+    beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, 1u, &hi);
+    grid->t_hi = t_up(hi, scale);
     return 1;
 }

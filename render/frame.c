@@ -112,11 +112,18 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
                          uint64_t *steps)
 {
     const camera *cam = job->cam;
-    double t_lo = 0.0, t_hi = INFINITY;
+    beam_grid g;
     int any = 1;
     if (job->beam_size) {
-        const beam_block b = beam_block_of(cam, i0, i1, j0, j1);
-        any = beam_window(job->tree, cam, &b, &t_lo, &t_hi);
+        any = beam_windows(job->tree, cam, i0, i1, j0, j1, &g);
+    } else { /* one sub-block, the whole ray */
+        g.cols = g.rows = 1;
+        g.col[0] = i0;
+        g.col[1] = i1;
+        g.row[0] = j0;
+        g.row[1] = j1;
+        g.t_lo[0][0] = 0.0;
+        g.t_hi = INFINITY;
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
         render_pixel(job, i0, j0, cam->forward, NULL, hits, steps);
@@ -138,16 +145,22 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
         }
         return;
     }
-    for (uint32_t j = j0; j < j1; j++) {
-        const double v = camera_v(cam, j);
-        for (uint32_t i = i0; i < i1; i++) {
-            double dir[3];
-            camera_ray_uv(cam, us[i - us0], v, dir);
-            trace_ray r;
-            const int traced = trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, t_hi);
-            render_pixel(job, i, j, dir, traced ? &r : NULL, hits, steps);
+    for (unsigned sr = 0; sr < g.rows; sr++)
+        for (unsigned sc = 0; sc < g.cols; sc++) {
+            const double t_lo = g.t_lo[sr][sc];
+            const int empty = !(t_lo < INFINITY); /* every ray of the sub-block misses */
+            for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++) {
+                const double v = camera_v(cam, j);
+                for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++) {
+                    double dir[3];
+                    camera_ray_uv(cam, us[i - us0], v, dir);
+                    trace_ray r;
+                    const int traced = !empty && trace_setup_eye(eye, dir, &r) &&
+                                       trace_clip(&r, t_lo, g.t_hi);
+                    render_pixel(job, i, j, dir, traced ? &r : NULL, hits, steps);
+                }
+            }
         }
-    }
 }
 
 static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t *hits,
