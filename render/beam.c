@@ -3,8 +3,6 @@
 
 #include <math.h>
 
-_Static_assert(BEAM_GRID * BEAM_GRID <= 32, "sub-block sets are 32-bit masks");
-
 typedef struct beam_block {
     double u0, u1, v0, v1; /* camera_u / camera_v of the block's extreme pixel centres */
 } beam_block;
@@ -53,12 +51,17 @@ static int pyramid_may_touch(const pyramid *p, const double c[3], double h)
     return 1;
 }
 
+/* Sub-blocks [c0, c1] x [r0, r1] (columns, rows). */
+typedef struct beam_rect {
+    uint8_t c0, c1, r0, r1;
+} beam_rect;
+
 typedef struct beam_item {
     uint64_t node;  /* index in its depth */
     uint32_t cell[3];
     unsigned depth;
     double dist;    /* its distance bound when it was pushed */
-    uint32_t grid;  /* the sub-blocks it may touch (bit r * BEAM_GRID + c) */
+    beam_rect reach; /* the sub-blocks it may touch */
 } beam_item;
 
 typedef struct beam_walk {
@@ -74,65 +77,57 @@ typedef struct beam_walk {
     double col_a[BEAM_GRID][3], col_m[BEAM_GRID], row_a[BEAM_GRID][3], row_m[BEAM_GRID];
 } beam_walk;
 
-/* The sub-blocks (bit r * BEAM_GRID + c) whose pyramids the box (centre c
- * relative to the eye, half edge h) may touch, assuming it may touch the
- * block's. u grows with the column; v falls with the row. */
-static uint32_t grid_touch(const beam_walk *bw, const double c[3], double h)
+/* Side of the box (centre c relative to the eye, half edge h) against the
+ * plane a through the eye: bit 0 when some of it may lie on the negative
+ * side, bit 1 on the positive side. */
+static unsigned box_side(const double a[3], double m, const double c[3], double h)
 {
-    unsigned cm = 0, rm = 0, right = 1, above = 1;
-    for (unsigned k = 0; k < bw->cols; k++) {
-        unsigned left = 1, next_right = 1; /* may lie left / right of boundary k + 1 */
-        if (k + 1 < bw->cols) {
-            const double *a = bw->col_a[k + 1];
-            const double sd = a[0] * c[0] + a[1] * c[1] + a[2] * c[2], e = h * bw->col_m[k + 1];
-            left = sd - e <= 0.0;
-            next_right = sd + e >= 0.0;
-        }
-        cm |= (right & left) << k;
-        right = next_right;
-    }
-    for (unsigned k = 0; k < bw->rows; k++) {
-        unsigned below = 1, next_above = 1; /* may lie below / above boundary k + 1 */
-        if (k + 1 < bw->rows) {
-            const double *a = bw->row_a[k + 1];
-            const double sd = a[0] * c[0] + a[1] * c[1] + a[2] * c[2], e = h * bw->row_m[k + 1];
-            next_above = sd + e >= 0.0;
-            below = sd - e <= 0.0;
-        }
-        /* row k lies above boundary k + 1 and below boundary k */
-        rm |= (above & next_above) << k;
-        above = below;
-    }
-    uint32_t m = 0;
-    for (unsigned r = 0; r < bw->rows; r++)
-        if (rm >> r & 1u)
-            m |= cm << (r * BEAM_GRID);
-    return m;
+    const double sd = a[0] * c[0] + a[1] * c[1] + a[2] * c[2], e = h * m;
+    return (unsigned)(sd - e <= 0.0) | (unsigned)(sd + e >= 0.0) << 1;
 }
 
-/* The bound a cell must beat to be worth opening for the sub-blocks in m:
+/* Narrows *r, the sub-blocks the box's parent may touch, to those whose
+ * pyramids the box may touch, assuming it may touch the block's (a box
+ * between two sub-blocks' pixel centres keeps one of them). Only the
+ * boundaries inside *r are tested. u grows with the column
+ * (a column boundary's positive side is to its right); v falls with the row
+ * (a row boundary's positive side is above it, towards row 0). */
+static void rect_touch(const beam_walk *bw, const double c[3], double h, beam_rect *r)
+{
+    unsigned c0 = r->c0, c1 = r->c1, r0 = r->r0, r1 = r->r1;
+    while (c0 < c1 && !(box_side(bw->col_a[c0 + 1], bw->col_m[c0 + 1], c, h) & 1u))
+        c0++; /* wholly right of boundary c0 + 1 */
+    while (c1 > c0 && !(box_side(bw->col_a[c1], bw->col_m[c1], c, h) & 2u))
+        c1--; /* wholly left of boundary c1 */
+    while (r0 < r1 && !(box_side(bw->row_a[r0 + 1], bw->row_m[r0 + 1], c, h) & 2u))
+        r0++; /* wholly below boundary r0 + 1 */
+    while (r1 > r0 && !(box_side(bw->row_a[r1], bw->row_m[r1], c, h) & 1u))
+        r1--; /* wholly above boundary r1 */
+    *r = (beam_rect){(uint8_t)c0, (uint8_t)c1, (uint8_t)r0, (uint8_t)r1};
+}
+
+/* The bound a cell must beat to be worth opening for the sub-blocks in r:
  * the largest of their nearest distances so far (a nearer cell improves at
- * least one of them), or the smallest of their farthest. -inf / +inf for
- * none. */
-static double grid_bound(const double *best, uint32_t m, int far)
+ * least one of them), or the smallest of their farthest. */
+static double rect_bound(const double (*best)[BEAM_GRID], beam_rect r, int far)
 {
     double b = far ? INFINITY : -INFINITY;
-    for (; m; m &= m - 1u) {
-        const double x = best[__builtin_ctz(m)];
-        b = far ? (x < b ? x : b) : (x > b ? x : b);
-    }
+    for (unsigned y = r.r0; y <= r.r1; y++)
+        for (unsigned x = r.c0; x <= r.c1; x++)
+            b = far ? (best[y][x] < b ? best[y][x] : b) : (best[y][x] > b ? best[y][x] : b);
     return b;
 }
 
 /* For every sub-block in `all`, the nearest (far = 0) or farthest (far = 1)
  * distance from the eye to an occupied cell of depth lim (1..levels) its
- * pyramid may touch, into best[] (set to +inf, or -inf, beforehand). One
+ * pyramid may touch, into best (set to +inf, or -inf, beforehand). One
  * walk serves them all: children nearest first for the nearest (farthest
  * first for the farthest), and a cell is opened only while it may touch
  * some sub-block whose distance it could still beat: a best-first search
  * along the front (or back) of the surface, not a sweep of the pyramid, with
  * the way down to the surface shared and only the last levels parting. */
-static void beam_extremes(const beam_walk *bw, int far, unsigned lim, uint32_t all, double *best)
+static void beam_extremes(const beam_walk *bw, int far, unsigned lim, beam_rect all,
+                          double (*best)[BEAM_GRID])
 {
     const oct_tree *tree = bw->tree;
     const double *o = bw->o;
@@ -142,7 +137,7 @@ static void beam_extremes(const beam_walk *bw, int far, unsigned lim, uint32_t a
     const unsigned order = bw->flip ^ (far ? 7u : 0u);
     while (sp) {
         const beam_item it = stack[--sp];
-        const double it_bound = grid_bound(best, it.grid, far);
+        const double it_bound = rect_bound(best, it.reach, far);
         if (far ? it.dist <= it_bound : it.dist >= it_bound)
             continue; /* the distances improved since it was pushed */
         const oct_group *g = &tree->groups[it.depth][it.node >> 3];
@@ -166,23 +161,23 @@ static void beam_extremes(const beam_walk *bw, int far, unsigned lim, uint32_t a
             const double dist = sqrt(d2);
             if ((far ? dist <= it_bound : dist >= it_bound) || !pyramid_may_touch(&bw->p, ctr, h))
                 continue;
-            const uint32_t touch = it.grid == 1u ? 1u : it.grid & grid_touch(bw, ctr, h);
-            if (!touch)
-                continue;
-            if (touch != it.grid) {
-                const double bound = grid_bound(best, touch, far);
+            beam_rect reach = it.reach;
+            if (reach.c0 != reach.c1 || reach.r0 != reach.r1) {
+                rect_touch(bw, ctr, h, &reach);
+                const double bound = rect_bound(best, reach, far);
                 if (far ? dist <= bound : dist >= bound)
                     continue;
             }
             if (it.depth + 1 == lim) {
-                for (uint32_t m = touch; m; m &= m - 1u) {
-                    double *b = &best[__builtin_ctz(m)];
-                    *b = (far ? dist > *b : dist < *b) ? dist : *b;
-                }
+                for (unsigned y = reach.r0; y <= reach.r1; y++)
+                    for (unsigned x = reach.c0; x <= reach.c1; x++) {
+                        double *b = &best[y][x];
+                        *b = (far ? dist > *b : dist < *b) ? dist : *b;
+                    }
                 continue;
             }
             stack[sp++] = (beam_item){oct_child_index(tree->groups[it.depth], it.node, c),
-                                      {cell[0], cell[1], cell[2]}, it.depth + 1, dist, touch};
+                                      {cell[0], cell[1], cell[2]}, it.depth + 1, dist, reach};
         }
     }
 }
@@ -250,17 +245,16 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
         bw.flip |= (cam->forward[i] < 0.0 ? 1u : 0u) << i;
     }
     bw.margin = 0x1p-12 + big * 0x1p-40;
-    double best[BEAM_GRID * BEAM_GRID];
-    uint32_t all = 0;
-    for (unsigned r = 0; r < bw.rows; r++)
-        all |= ((1u << bw.cols) - 1u) << (r * BEAM_GRID);
-    for (unsigned k = 0; k < BEAM_GRID * BEAM_GRID; k++)
-        best[k] = INFINITY;
-    beam_extremes(&bw, 0, levels, all, best);
+    double best[BEAM_GRID][BEAM_GRID];
+    for (unsigned r = 0; r < BEAM_GRID; r++)
+        for (unsigned c = 0; c < BEAM_GRID; c++)
+            best[r][c] = INFINITY;
+    beam_extremes(&bw, 0, levels,
+                  (beam_rect){0, (uint8_t)(bw.cols - 1), 0, (uint8_t)(bw.rows - 1)}, best);
     int any = 0;
     for (unsigned r = 0; r < bw.rows; r++)
         for (unsigned c = 0; c < bw.cols; c++) {
-            const double lo = best[r * BEAM_GRID + c];
+            const double lo = best[r][c];
             grid->t_lo[r][c] = lo < INFINITY ? t_down(lo, scale) : INFINITY;
             any |= lo < INFINITY;
         }
@@ -269,8 +263,8 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
     /* The far end, for the whole block, only stops rays that miss: the
      * voxels' parents of depth L - 3 bound it a few voxels later for far
      * fewer opened cells (RENDER.md, "Beam"). */
-    double hi = -INFINITY;
-    beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, 1u, &hi);
-    grid->t_hi = t_up(hi, scale);
+    double hi[BEAM_GRID][BEAM_GRID] = {{-INFINITY}}; /* [0][0]: the whole block */
+    beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, (beam_rect){0, 0, 0, 0}, hi);
+    grid->t_hi = t_up(hi[0][0], scale);
     return 1;
 }
