@@ -268,3 +268,42 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
     grid->t_hi = t_up(hi[0][0], scale);
     return 1;
 }
+
+void beam_start_box(const camera *cam, const double o[3], double scale, uint32_t i0, uint32_t i1,
+                    uint32_t j0, uint32_t j1, double t, double lo[3], double hi[3])
+{
+    /* A ray's unit direction is w / |w|, w = F + uR + vU, with |w|^2 =
+     * 1 + u^2 + v^2 (F, R, U orthonormal to rounding); w lies in the hull
+     * of the four corner pixels' w and |w| between its least and greatest
+     * over the block, so the point lies in the hull of the corners' w
+     * scaled by t over both extremes of |w|. */
+    const double u[2] = {camera_u(cam, i0), camera_u(cam, i1 - 1)};
+    const double v[2] = {camera_v(cam, j1 - 1), camera_v(cam, j0)};
+    const double u_in = u[0] <= 0.0 && u[1] >= 0.0 ? 0.0 : fmin(u[0] * u[0], u[1] * u[1]);
+    const double v_in = v[0] <= 0.0 && v[1] >= 0.0 ? 0.0 : fmin(v[0] * v[0], v[1] * v[1]);
+    const double u_out = fmax(u[0] * u[0], u[1] * u[1]), v_out = fmax(v[0] * v[0], v[1] * v[1]);
+    const double s[2] = {t * scale / (sqrt(1.0 + u_out + v_out) * (1.0 + 0x1p-40)),
+                         t * scale / (sqrt(1.0 + u_in + v_in) * (1.0 - 0x1p-40))};
+    double big = 0.0;
+    for (int i = 0; i < 3; i++) {
+        lo[i] = INFINITY;
+        hi[i] = -INFINITY;
+        big = fmax(big, fabs(o[i]));
+    }
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++)
+            for (int i = 0; i < 3; i++) {
+                const double w = cam->forward[i] + u[a] * cam->right[i] + v[b] * cam->up[i];
+                for (int k = 0; k < 2; k++) {
+                    const double p = o[i] + s[k] * w;
+                    lo[i] = fmin(lo[i], p);
+                    hi[i] = fmax(hi[i], p);
+                }
+            }
+    /* 2^-10 voxel plus 2^-36 of the magnitudes involved */
+    const double margin = 0x1p-10 + (big + s[1] * 2.0) * 0x1p-36;
+    for (int i = 0; i < 3; i++) {
+        lo[i] -= margin;
+        hi[i] += margin;
+    }
+}

@@ -48,4 +48,12 @@ typedef struct beam_grid {
 int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
                  uint32_t j1, beam_grid *grid);
 
+/* A box (grid units) holding the point at distance t (the caller's t along
+ * unit rays) of every ray through the pixel centres [i0, i1) x [j0, j1)
+ * from the eye at grid position o, scale grid units a caller unit; grown by
+ * a margin far above the rounding of those points as the traversal
+ * computes them. For trace_anchor_find. */
+void beam_start_box(const camera *cam, const double o[3], double scale, uint32_t i0, uint32_t i1,
+                    uint32_t j0, uint32_t j1, double t, double lo[3], double hi[3]);
+
 #endif

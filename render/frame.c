@@ -76,11 +76,12 @@ uint8_t frame_srgb8(float x)
 /* Traces, shades and stores pixel (i, j); r is its prepared ray, or NULL
  * for a ray known to miss. */
 static inline void render_pixel(const frame_job *job, uint32_t i, uint32_t j, const double dir[3],
-                                const trace_ray *r, uint64_t *hits, uint64_t *steps)
+                                const trace_ray *r, const trace_anchor *an, uint64_t *hits,
+                                uint64_t *steps)
 {
     trace_hit h;
     if (r) {
-        trace_ray_prepared(job->tree, &job->opts, r, &h);
+        trace_ray_anchored(job->tree, &job->opts, r, an, &h);
     } else { /* trace_ray_cast's miss */
         h.hit = 0;
         h.t = INFINITY;
@@ -126,7 +127,7 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
         g.t_hi = INFINITY;
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
-        render_pixel(job, i0, j0, cam->forward, NULL, hits, steps);
+        render_pixel(job, i0, j0, cam->forward, NULL, NULL, hits, steps);
         const size_t p0 = (size_t)j0 * cam->width + i0, w = i1 - i0;
         uint8_t *row0 = job->rgb + 3 * p0;
         for (size_t k = 1; k < w; k++)
@@ -149,6 +150,16 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
         for (unsigned sc = 0; sc < g.cols; sc++) {
             const double t_lo = g.t_lo[sr][sc];
             const int empty = !(t_lo < INFINITY); /* every ray of the sub-block misses */
+            /* the sub-block's rays all start at t_lo: where they do, the
+             * descent from the root is shared */
+            trace_anchor an;
+            an.depth = 0;
+            if (!empty && eye->ok) {
+                double lo[3], hi[3];
+                beam_start_box(cam, eye->o, eye->scale, g.col[sc], g.col[sc + 1], g.row[sr],
+                               g.row[sr + 1], t_lo, lo, hi);
+                trace_anchor_find(job->tree, lo, hi, &an);
+            }
             for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++) {
                 const double v = camera_v(cam, j);
                 for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++) {
@@ -157,7 +168,7 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
                     trace_ray r;
                     const int traced = !empty && trace_setup_eye(eye, dir, &r) &&
                                        trace_clip(&r, t_lo, g.t_hi);
-                    render_pixel(job, i, j, dir, traced ? &r : NULL, hits, steps);
+                    render_pixel(job, i, j, dir, traced ? &r : NULL, &an, hits, steps);
                 }
             }
         }

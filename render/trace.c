@@ -3,6 +3,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #if defined(__SSE4_1__)
@@ -161,6 +162,48 @@ int trace_clip(trace_ray *r, double t_lo, double t_hi)
     return r->t_start < r->t_end;
 }
 
+void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
+                       trace_anchor *a)
+{
+    const unsigned levels = tree->levels;
+    a->depth = 0;
+    a->cell[0] = a->cell[1] = a->cell[2] = 0;
+    a->node[0].prefix = tree->groups[0][0].base;
+    a->node[0].mask = tree->groups[0][0].mask[0];
+    a->node[0].ci = 0;
+    const double n = (double)(UINT32_C(1) << levels);
+    for (int i = 0; i < 3; i++)
+        if (!(lo[i] > 0.0 && hi[i] < n && lo[i] <= hi[i])) /* NaN too */
+            return;
+    /* whole voxels: the box lies in voxels [vl, vh] */
+    uint32_t vl[3], vh[3];
+    for (int i = 0; i < 3; i++) {
+        vl[i] = (uint32_t)lo[i];
+        vh[i] = (uint32_t)hi[i];
+    }
+    for (unsigned d = 1; d < levels; d++) {
+        const unsigned sh = levels - d;
+        if ((vl[0] >> sh) != (vh[0] >> sh) || (vl[1] >> sh) != (vh[1] >> sh) ||
+            (vl[2] >> sh) != (vh[2] >> sh))
+            return; /* the box straddles two cells of depth d */
+        const unsigned c = (vl[0] >> sh & 1u) | (vl[1] >> sh & 1u) << 1 | (vl[2] >> sh & 1u) << 2;
+        const uint32_t m = a->node[d - 1].mask;
+        if (!(m >> c & 1u))
+            return; /* an empty cell: its parent is the deepest occupied one */
+        const uint64_t idx = a->node[d - 1].prefix + oct_popcount64(m & ((1u << c) - 1u));
+        const oct_group *gr = &tree->groups[d][idx >> 3];
+        const unsigned k = (unsigned)(idx & 7u);
+        uint64_t masks;
+        memcpy(&masks, gr->mask, 8);
+        a->node[d].mask = (uint32_t)(masks >> (8 * k)) & 0xffu;
+        a->node[d].prefix = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+        a->node[d].ci = c;
+        a->depth = d;
+        for (int i = 0; i < 3; i++)
+            a->cell[i] = vl[i] >> sh << sh;
+    }
+}
+
 /* --refine in one occupied voxel `idx` (corner v), which the ray occupies
  * for local t in [t_in, t_out]. The stored plane n . (p - centre) = offset
  * (voxel units) splits space into s > 0 and s < 0, s(t) = n . (p(t) -
@@ -207,10 +250,29 @@ static int refine_voxel(const oct_tree *tree, const trace_ray *r, uint64_t idx,
  * and it never equals a step time te < t_end, so its mask bits are 0. The
  * arithmetic per lane is the scalar T() above, operation for operation. */
 typedef struct trace_frame_v {
-    __m128d txy, tzw; /* exit times of the node's cell */
     uint64_t prefix;
     uint32_t mask, ci;
 } trace_frame_v;
+/* trace_anchor's nodes are copied onto the frames */
+_Static_assert(sizeof(trace_frame_v) == 16 && offsetof(trace_frame_v, mask) == 8 &&
+                   offsetof(trace_frame_v, ci) == 12 && sizeof(((trace_anchor *)0)->node[0]) == 16,
+               "trace_anchor node layout");
+
+/* The exit times of the cell with corner V (bits below `edge` ignored) and
+ * edge `edge`, T(corner + far * edge) per axis: the same T of the same
+ * planes as a descent blends from mid-plane times, bit for bit. FARM has
+ * all bits set in the lanes of the far axes; the dummy lane w comes out 0
+ * and is raised to +inf by WINF = (-inf, +inf). */
+static inline void trace_cell_exits(__m128i V, uint32_t edge, __m128i FARM, __m128d ZOxy,
+                                    __m128d ZOzw, __m128d ZIxy, __m128d ZIzw, __m128d WINF,
+                                    __m128d *txy, __m128d *tzw)
+{
+    const __m128i C = _mm_andnot_si128(_mm_set1_epi32((int32_t)(edge - 1u)), V);
+    const __m128i K = _mm_add_epi32(C, _mm_and_si128(_mm_set1_epi32((int32_t)edge), FARM));
+    *txy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(K), ZOxy), ZIxy);
+    *tzw = _mm_max_pd(_mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(K, K)), ZOzw), ZIzw),
+                      WINF);
+}
 
 /* lane masks for a 3-bit axis set */
 static const int32_t trace_lut[8][4] __attribute__((aligned(16))) = {
@@ -269,8 +331,8 @@ trace_walk_empty(__m128i V, uint32_t size, __m128d TC, __m128d Wxy, __m128d Wzw,
     }
 }
 
-int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
-                       trace_hit *hit)
+static int trace_ray_run(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                         const trace_anchor *anchor, trace_hit *hit)
 {
     const unsigned levels = tree->levels;
     hit->hit = 0;
@@ -301,12 +363,16 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     const __m128d ZOxy = _mm_loadu_pd(zo), ZOzw = _mm_loadu_pd(zo + 2);
     const __m128d ZIxy = _mm_loadu_pd(zi), ZIzw = _mm_loadu_pd(zi + 2);
 
+    const __m128i FARM = _mm_setr_epi32(-(int32_t)(far & 1u), -(int32_t)(far >> 1 & 1u),
+                                        -(int32_t)(far >> 2 & 1u), 0);
+    const __m128d WINF = _mm_setr_pd(-INFINITY, INFINITY);
+
+    /* the nodes from the root down to the current cell's parent; exit times
+     * are recomputed when the ray climbs back */
     trace_frame_v fr[OCT_MAX_LEVELS];
     __m128d TPxy = _mm_loadu_pd(root), TPzw = _mm_loadu_pd(root + 2);
     uint32_t M = groups[0][0].mask[0];
     uint64_t P = groups[0][0].base;
-    fr[0].txy = TPxy;
-    fr[0].tzw = TPzw;
     fr[0].mask = M;
     fr[0].prefix = P;
     fr[0].ci = 0;
@@ -318,6 +384,18 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
     uint32_t steps = 0;
     int side = 0; /* --refine: see refine_voxel */
 
+    if (anchor && anchor->depth) {
+        /* the start lies in the anchor's cell: the descent from the root
+         * would take its path */
+        d = anchor->depth;
+        memcpy(fr, anchor->node, (d + 1) * sizeof fr[0]);
+        size = UINT32_C(1) << (levels - d);
+        V = _mm_setr_epi32((int32_t)anchor->cell[0], (int32_t)anchor->cell[1],
+                           (int32_t)anchor->cell[2], 0);
+        trace_cell_exits(V, size, FARM, ZOxy, ZOzw, ZIxy, ZIzw, WINF, &TPxy, &TPzw);
+        M = fr[d].mask;
+        P = fr[d].prefix;
+    }
     goto enter;
     for (;;) {
         uint32_t Mn;
@@ -363,8 +441,6 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             goto step;
         }
         /* the cell becomes the parent: push it, then enter its child */
-        fr[d].txy = Txy;
-        fr[d].tzw = Tzw;
         fr[d].mask = Mn;
         fr[d].prefix = Pn;
         fr[d].ci = ci;
@@ -397,28 +473,29 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             break;
         __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
         unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
-        while (~(ci ^ far) & smask) {
-            d--;
-            if (d == 0)
-                goto out;
-            size <<= 1;
+        if (~(ci ^ far) & smask) {
+            do {
+                d--;
+                if (d == 0)
+                    goto out;
+                size <<= 1;
+                ci = fr[d].ci;
+                /* One stepped axis a, on the far half: the parent's exit on a
+                 * is the same plane (= te) and its other exits are later, so
+                 * its stepped set is {a} again; only ties need comparing
+                 * anew, with the parent's own exit times. */
+                if (smask & (smask - 1u)) {
+                    trace_cell_exits(V, size, FARM, ZOxy, ZOzw, ZIxy, ZIzw, WINF, &Txy, &Tzw);
+                    Exy = _mm_cmpeq_pd(Txy, TEv);
+                    Ezw = _mm_cmpeq_pd(Tzw, TEv);
+                    smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+                }
+            } while (~(ci ^ far) & smask);
             V = _mm_andnot_si128(_mm_set1_epi32((int32_t)(size - 1u)), V);
-            Txy = TPxy;
-            Tzw = TPzw;
-            ci = fr[d].ci;
-            const trace_frame_v *pf = &fr[d - 1];
-            M = pf->mask;
-            P = pf->prefix;
-            TPxy = pf->txy;
-            TPzw = pf->tzw;
-            /* One stepped axis a, on the far half: the parent's exit on a is
-             * the same plane (= te) and its other exits are later, so its
-             * stepped set is {a} again; only ties need comparing anew. */
-            if (smask & (smask - 1u)) {
-                Exy = _mm_cmpeq_pd(Txy, TEv);
-                Ezw = _mm_cmpeq_pd(Tzw, TEv);
-                smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
-            }
+            trace_cell_exits(V, size, FARM, ZOxy, ZOzw, ZIxy, ZIzw, WINF, &Txy, &Tzw);
+            trace_cell_exits(V, 2u * size, FARM, ZOxy, ZOzw, ZIxy, ZIzw, WINF, &TPxy, &TPzw);
+            M = fr[d - 1].mask;
+            P = fr[d - 1].prefix;
         }
         ci ^= smask;
         Txy = _mm_blendv_pd(Txy, TPxy, Exy);
@@ -436,6 +513,18 @@ out:;
     hit->xyz[2] = v[2];
     hit->steps = steps;
     return hit->hit;
+}
+
+int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       trace_hit *hit)
+{
+    return trace_ray_run(tree, opts, r, NULL, hit);
+}
+
+int trace_ray_anchored(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       const trace_anchor *a, trace_hit *hit)
+{
+    return trace_ray_run(tree, opts, r, a, hit);
 }
 #else
 /* One node of the descent stack: the node's child mask and first-child index,
@@ -628,6 +717,14 @@ out:
     hit->xyz[2] = vz;
     hit->steps = steps;
     return hit->hit;
+}
+
+/* The scalar build descends from the root for every ray. */
+int trace_ray_anchored(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       const trace_anchor *a, trace_hit *hit)
+{
+    (void)a;
+    return trace_ray_prepared(tree, opts, r, hit);
 }
 #endif
 

@@ -130,4 +130,29 @@ int trace_ray_cast(const oct_tree *tree, const trace_opts *opts, const double ey
 int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
                        trace_hit *hit);
 
+/* A start shared by a set of rays: the deepest occupied cell holding every
+ * one of their start points, with the nodes from the root down to it. */
+typedef struct trace_anchor {
+    unsigned depth;   /* 0: the root, no help */
+    uint32_t cell[3]; /* the cell's corner, in voxels */
+    struct {          /* laid out as the traversal's own frames */
+        uint64_t prefix; /* index in the next depth of the node's first child */
+        uint32_t mask;   /* child mask */
+        uint32_t ci;     /* child index in its parent */
+    } node[OCT_MAX_LEVELS]; /* depths 0..depth */
+} trace_anchor;
+
+/* The anchor for start points known to lie in the box [lo, hi] (grid
+ * units: the root cube is [0, N]^3), the box already grown by a margin
+ * above the rounding of the rays' start points and plane times. A box not
+ * inside the root cube gets the root. */
+void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
+                       trace_anchor *a);
+
+/* trace_ray_prepared for a ray whose start point (at r->t_start) lies in
+ * the box a was found for: the descent begins at the anchor. Hit, voxel, t
+ * and step count are those of trace_ray_prepared, bit for bit. */
+int trace_ray_anchored(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
+                       const trace_anchor *a, trace_hit *hit);
+
 #endif

@@ -507,6 +507,131 @@ static void test_clip_same_hit(void **state)
     assert_true(steps_clipped < steps_whole * 3 / 4); /* they do start later */
 }
 
+/* trace_ray_anchored: rays whose start points lie in a box begin at the
+ * deepest occupied cell holding the box and meet the same voxel at the same
+ * t, with the same step count and end cell, as from the root. Groups of
+ * rays share one box (the hull of their start points, grown by 2^-10
+ * voxel, as the renderer grows its boxes); starts at plane times put start
+ * points on cell faces, where the box must straddle. */
+static void test_anchored_same_hit(void **state)
+{
+    (void)state;
+    unsigned long checked = 0, anchored = 0, depth_sum = 0;
+    unsigned deepest = 0;
+    for (int tr = 0; tr < 24; tr++) {
+        const unsigned L = 3 + irand(6);
+        const uint32_t N = 1u << L;
+        const size_t n = 1 + irand(N * N + 1);
+        uint32_t(*xyz)[3] = malloc(n * sizeof *xyz);
+        uint32_t *attr = malloc(n * sizeof *attr);
+        assert_non_null(xyz);
+        assert_non_null(attr);
+        size_t m = 0;
+        /* clustered off the root's mid-planes, so that occupied cells nest
+         * deeply */
+        const uint32_t width = N / 4 + 1, c0 = N / 8 + irand(N / 2 + 1);
+        for (size_t i = 0; i < n; i++) {
+            uint32_t v[3] = {c0 + irand(width), c0 + irand(width), c0 + irand(width)};
+            int dup = 0;
+            for (size_t j = 0; j < m && !dup; j++)
+                dup = !memcmp(xyz[j], v, sizeof v);
+            if (dup)
+                continue;
+            memcpy(xyz[m], v, sizeof v);
+            attr[m] = (uint32_t)m + 1;
+            m++;
+        }
+        const double origin[3] = {0, 0, 0};
+        oct_tree *t = tree_util_build(L, origin, (double)N, (const uint32_t(*)[3])xyz, m, attr, NULL,
+                                      1, NULL);
+        assert_non_null(t);
+        for (int group = 0; group < 120; group++) {
+            const int group_size = 1 + (int)irand(6);
+            const double spread = irand(2) ? 0.02 : 0.001;
+            /* a few rays from one eye with nearby directions, started at one
+             * distance (a plane time of the first ray, or anywhere) */
+            double eye[3], dir0[3];
+            for (int a = 0; a < 3; a++) {
+                eye[a] = irand(2) ? (double)irand(4 * (N + 4)) / 4.0 - 2.0
+                                  : -2.0 * N + 5.0 * N * urand();
+                dir0[a] = irand(3) ? 2.0 * urand() - 1.0 : (double)irand(5) - 2.0;
+            }
+            trace_ray r0;
+            if (!trace_setup(t, eye, dir0, &r0))
+                continue;
+            /* start at a plane time, anywhere, at the whole ray's hit or
+             * shortly before it (deep in occupied cells) */
+            double t_start;
+            const int a0 = (int)irand(3);
+            const trace_opts whole = {L, 0};
+            trace_hit hw;
+            const int how = (int)irand(4);
+            if (how == 0 && (r0.active >> a0 & 1)) {
+                const double tl = trace_plane_time(&r0, a0, (double)irand(N + 1));
+                if (!(tl >= 0.0 && tl < r0.t_end))
+                    continue;
+                t_start = r0.t_base + tl;
+            } else if (how >= 2 && trace_ray_prepared(t, &whole, &r0, &hw)) {
+                t_start = how == 2 ? hw.t : hw.t - urand() * 2.0 * (hw.t - r0.t_base);
+                if (!(t_start >= r0.t_base))
+                    t_start = r0.t_base;
+            } else {
+                t_start = r0.t_base + urand() * (r0.t_end);
+            }
+            trace_ray rays[6];
+            int nr = 0;
+            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (int k = 0; k < group_size; k++) {
+                double dir[3];
+                for (int a = 0; a < 3; a++)
+                    dir[a] = dir0[a] + (k ? (urand() - 0.5) * spread : 0.0);
+                trace_ray r;
+                if (!trace_setup(t, eye, dir, &r) || !trace_clip(&r, t_start, INFINITY))
+                    continue;
+                for (int a = 0; a < 3; a++) {
+                    const double p = r.o[a] + r.t_start * r.d[a];
+                    lo[a] = p < lo[a] ? p : lo[a];
+                    hi[a] = p > hi[a] ? p : hi[a];
+                }
+                rays[nr++] = r;
+            }
+            if (!nr)
+                continue;
+            for (int a = 0; a < 3; a++) {
+                lo[a] -= 0x1p-10;
+                hi[a] += 0x1p-10;
+            }
+            trace_anchor an;
+            trace_anchor_find(t, lo, hi, &an);
+            anchored += an.depth > 0;
+            depth_sum += an.depth;
+            deepest = an.depth > deepest ? an.depth : deepest;
+            for (int k = 0; k < nr; k++)
+                for (int refine = 0; refine <= 1; refine++) {
+                    const trace_opts op = {irand(2) ? L : irand(L + 1), refine};
+                    trace_hit h0, h1;
+                    trace_ray_prepared(t, &op, &rays[k], &h0);
+                    trace_ray_anchored(t, &op, &rays[k], &an, &h1);
+                    assert_int_equal(h1.hit, h0.hit);
+                    assert_true(h1.voxel == h0.voxel || !h0.hit);
+                    assert_true(h1.t == h0.t || (isinf(h1.t) && isinf(h0.t)));
+                    assert_int_equal(h1.steps, h0.steps);
+                    assert_memory_equal(h1.xyz, h0.xyz, sizeof h0.xyz);
+                    checked++;
+                }
+        }
+        tree_util_free(t);
+        free(xyz);
+        free(attr);
+    }
+    print_message("anchored: %lu traversals the same, %lu groups anchored below the root "
+                  "(mean depth %.2f, deepest %u)\n",
+                  checked, anchored, anchored ? (double)depth_sum / (double)anchored : 0.0,
+                  deepest);
+    assert_true(checked > 2000);
+    assert_true(anchored > 100 && deepest >= 4); /* the anchors do go below the root */
+}
+
 int main(void)
 {
     /* TEST_SEED=N replays another deterministic stream of rays and trees */
@@ -519,6 +644,7 @@ int main(void)
         cmocka_unit_test(test_random_trees_vs_oracle),
         cmocka_unit_test(test_deep_single_path),
         cmocka_unit_test(test_clip_same_hit),
+        cmocka_unit_test(test_anchored_same_hit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
