@@ -109,8 +109,10 @@ static void rect_touch(const beam_walk *bw, const double c[3], double h, beam_re
 /* The bound a cell must beat to be worth opening for the sub-blocks in r:
  * the largest of their nearest distances so far (a nearer cell improves at
  * least one of them), or the smallest of their farthest. */
-static double rect_bound(const double (*best)[BEAM_GRID], beam_rect r, int far)
+static inline double rect_bound(const double (*best)[BEAM_GRID], beam_rect r, int far)
 {
+    if (r.c0 == r.c1 && r.r0 == r.r1) /* deep cells reach one sub-block */
+        return best[r.r0][r.c0];
     double b = far ? INFINITY : -INFINITY;
     for (unsigned y = r.r0; y <= r.r1; y++)
         for (unsigned x = r.c0; x <= r.c1; x++)
