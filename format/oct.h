@@ -107,6 +107,25 @@ static inline uint64_t oct_child_index(const oct_group *g, uint64_t node, unsign
     return gr->base + oct_popcount64(before) + oct_popcount64(within);
 }
 
+/* The child mask of `node` and the index, in the next depth (or the voxel
+ * array), of its first child: what a traversal keeps of a node it enters. */
+typedef struct oct_children {
+    uint64_t first;
+    uint32_t mask;
+} oct_children;
+
+static inline oct_children oct_node_children(const oct_group *g, uint64_t node)
+{
+    const oct_group *gr = &g[node >> 3];
+    unsigned k = (unsigned)(node & 7);
+    uint64_t masks;
+    memcpy(&masks, gr->mask, 8); /* little-endian host: mask[j] is byte j */
+    oct_children c;
+    c.mask = (uint32_t)(masks >> (8 * k)) & 0xffu;
+    c.first = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1)); /* k < 8 */
+    return c;
+}
+
 /* --- Reader ------------------------------------------------------------ */
 
 typedef struct oct_file oct_file;

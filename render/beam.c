@@ -184,6 +184,29 @@ static void beam_extremes(const beam_walk *bw, int far, unsigned lim, beam_rect 
     }
 }
 
+/* How far the camera's basis is from orthonormal, for the block's (u, v):
+ * the pyramid's planes and beam_start_box take F, R, U orthonormal, but
+ * camera_init's right, normalise(F x up), leaves F by up to about 1e-7 when
+ * up lies within a sine of 1e-9 of F (which it accepts). With e the largest
+ * of |F.R|, |F.U|, |R.U| and ||X|^2 - 1|, w = F + uR + vU meets each plane,
+ * and |w|^2 meets 1 + u^2 + v^2, within 4 e (1 + |u| + |v|)^2 of the
+ * orthonormal values (relative to |w|). */
+static double basis_slack(const camera *cam, double umax, double vmax)
+{
+    const double *F = cam->forward, *R = cam->right, *U = cam->up;
+    const double d[6] = {F[0] * R[0] + F[1] * R[1] + F[2] * R[2],
+                         F[0] * U[0] + F[1] * U[1] + F[2] * U[2],
+                         R[0] * U[0] + R[1] * U[1] + R[2] * U[2],
+                         F[0] * F[0] + F[1] * F[1] + F[2] * F[2] - 1.0,
+                         R[0] * R[0] + R[1] * R[1] + R[2] * R[2] - 1.0,
+                         U[0] * U[0] + U[1] * U[1] + U[2] * U[2] - 1.0};
+    double e = 0x1p-50; /* the rounding of these sums themselves */
+    for (int k = 0; k < 6; k++)
+        e = fmax(e, fabs(d[k]));
+    const double g = 1.0 + umax + vmax;
+    return 4.0 * e * g * g;
+}
+
 /* Grid distance -> the caller's t (unit directions), widened outward by a
  * relative 2^-40 for the division and a direction's length of 1 +- ulps. */
 static double t_down(double dist, double scale) { return dist / scale * (1.0 - 0x1p-40); }
@@ -246,7 +269,11 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
         big = fmax(big, fabs(bw.o[i]));
         bw.flip |= (cam->forward[i] < 0.0 ? 1u : 0u) << i;
     }
-    bw.margin = 0x1p-12 + big * 0x1p-40;
+    /* ... plus what a basis off orthonormal can move a ray off a plane at
+     * any distance in the walk (below |o| + sqrt(3) N) */
+    const double slack =
+        basis_slack(cam, fmax(fabs(b.u0), fabs(b.u1)), fmax(fabs(b.v0), fabs(b.v1)));
+    bw.margin = 0x1p-12 + big * 0x1p-40 + slack * 2.0 * (2.0 * big + 2.0 * n);
     double best[BEAM_GRID][BEAM_GRID];
     for (unsigned r = 0; r < BEAM_GRID; r++)
         for (unsigned c = 0; c < BEAM_GRID; c++)
@@ -265,9 +292,9 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
     /* The far end, for the whole block, only stops rays that miss: the
      * voxels' parents of depth L - 3 bound it a few voxels later for far
      * fewer opened cells (RENDER.md, "Beam"). */
-    double hi[BEAM_GRID][BEAM_GRID] = {{-INFINITY}}; /* [0][0]: the whole block */
-    beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, (beam_rect){0, 0, 0, 0}, hi);
-    grid->t_hi = t_up(hi[0][0], scale);
+    double far_best[1][BEAM_GRID] = {{-INFINITY}}; /* [0][0]: the whole block */
+    beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, (beam_rect){0, 0, 0, 0}, far_best);
+    grid->t_hi = t_up(far_best[0][0], scale);
     return 1;
 }
 
@@ -275,17 +302,19 @@ void beam_start_box(const camera *cam, const double o[3], double scale, uint32_t
                     uint32_t j0, uint32_t j1, double t, double lo[3], double hi[3])
 {
     /* A ray's unit direction is w / |w|, w = F + uR + vU, with |w|^2 =
-     * 1 + u^2 + v^2 (F, R, U orthonormal to rounding); w lies in the hull
-     * of the four corner pixels' w and |w| between its least and greatest
-     * over the block, so the point lies in the hull of the corners' w
-     * scaled by t over both extremes of |w|. */
+     * 1 + u^2 + v^2 within basis_slack; w lies in the hull of the four
+     * corner pixels' w and |w| between its least and greatest over the
+     * block, so the point lies in the hull of the corners' w scaled by t
+     * over both extremes of |w|. */
     const double u[2] = {camera_u(cam, i0), camera_u(cam, i1 - 1)};
     const double v[2] = {camera_v(cam, j1 - 1), camera_v(cam, j0)};
     const double u_in = u[0] <= 0.0 && u[1] >= 0.0 ? 0.0 : fmin(u[0] * u[0], u[1] * u[1]);
     const double v_in = v[0] <= 0.0 && v[1] >= 0.0 ? 0.0 : fmin(v[0] * v[0], v[1] * v[1]);
     const double u_out = fmax(u[0] * u[0], u[1] * u[1]), v_out = fmax(v[0] * v[0], v[1] * v[1]);
-    const double s[2] = {t * scale / (sqrt(1.0 + u_out + v_out) * (1.0 + 0x1p-40)),
-                         t * scale / (sqrt(1.0 + u_in + v_in) * (1.0 - 0x1p-40))};
+    const double slack = basis_slack(cam, sqrt(u_out), sqrt(v_out));
+    const double w_in = sqrt(fmax(1.0 + u_in + v_in - slack, 0x1p-60)) * (1.0 - 0x1p-40);
+    const double w_out = sqrt(1.0 + u_out + v_out + slack) * (1.0 + 0x1p-40);
+    const double s[2] = {t * scale / w_out, t * scale / w_in};
     double big = 0.0;
     for (int i = 0; i < 3; i++) {
         lo[i] = INFINITY;

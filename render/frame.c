@@ -105,9 +105,9 @@ static inline void render_pixel(const frame_job *job, uint32_t i, uint32_t j, co
     *steps += h.steps;
 }
 
-/* The pixels [i0, i1) x [j0, j1): with a beam window, each ray is traced
- * inside it only, and none at all when the block's pyramid touches no
- * occupied cell. */
+/* The pixels [i0, i1) x [j0, j1): with the beam, each sub-block's rays are
+ * traced inside its window only, from its anchor, and none at all when its
+ * pyramid touches no occupied cell. */
 static void render_block(const frame_job *job, const trace_eye *eye, const double *us, uint32_t us0,
                          uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1, uint64_t *hits,
                          uint64_t *steps)

@@ -168,6 +168,8 @@ void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi
     const unsigned levels = tree->levels;
     a->depth = 0;
     a->cell[0] = a->cell[1] = a->cell[2] = 0;
+    if (tree->node_count[0] == 0 || levels < 1 || levels > OCT_MAX_LEVELS)
+        return; /* an empty tree: nothing to anchor */
     a->node[0].prefix = tree->groups[0][0].base;
     a->node[0].mask = tree->groups[0][0].mask[0];
     a->node[0].ci = 0;
@@ -191,12 +193,9 @@ void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi
         if (!(m >> c & 1u))
             return; /* an empty cell: its parent is the deepest occupied one */
         const uint64_t idx = a->node[d - 1].prefix + oct_popcount64(m & ((1u << c) - 1u));
-        const oct_group *gr = &tree->groups[d][idx >> 3];
-        const unsigned k = (unsigned)(idx & 7u);
-        uint64_t masks;
-        memcpy(&masks, gr->mask, 8);
-        a->node[d].mask = (uint32_t)(masks >> (8 * k)) & 0xffu;
-        a->node[d].prefix = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+        const oct_children ch = oct_node_children(tree->groups[d], idx);
+        a->node[d].mask = ch.mask;
+        a->node[d].prefix = ch.first;
         a->node[d].ci = c;
         a->depth = d;
         for (int i = 0; i < 3; i++)
@@ -423,12 +422,9 @@ static int trace_ray_run(const oct_tree *tree, const trace_opts *opts, const tra
                 }
                 goto step;
             }
-            const oct_group *gr = &groups[d][n >> 3];
-            const unsigned k = (unsigned)(n & 7u);
-            uint64_t masks;
-            memcpy(&masks, gr->mask, 8);
-            Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
-            Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+            const oct_children ch = oct_node_children(groups[d], n);
+            Mn = ch.mask;
+            Pn = ch.first;
         } else {
             if (d > split && d < levels) {
                 /* step two, below K: walk the empty cell voxel by voxel */
@@ -612,12 +608,9 @@ int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace
             uint64_t Pn = 0;
             if (occ) {
                 const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
-                const oct_group *gr = &groups[d][n >> 3];
-                const unsigned k = (unsigned)(n & 7u);
-                uint64_t masks;
-                memcpy(&masks, gr->mask, 8);
-                Mn = (uint32_t)(masks >> (8 * k)) & 0xffu;
-                Pn = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1u));
+                const oct_children ch = oct_node_children(groups[d], n);
+            Mn = ch.mask;
+            Pn = ch.first;
             }
             fr[d].tex[0] = tx;
             fr[d].tex[1] = ty;

@@ -305,12 +305,102 @@ static void test_beam_far_from_origin(void **state)
     free(a), free(b), free(da), free(db), free(xyz), free(attr);
 }
 
+/* A skewed camera: camera_init accepts an up within a sine of 1e-9 of the
+ * view, and right = normalise(forward x up) then leaves forward by up to
+ * about 1e-7. Far from the eye (3e5 voxels, level 18) that moves a ray by
+ * more than any fixed margin; the beam must widen for it (a review found the
+ * anchors placed past the rays' start, changing the depth of a pixel). The
+ * camera searched for is the most skewed of many; the cube is slid so that
+ * the ray through pixel (1, 0) grazes a voxel's corner. */
+static uint64_t skew_rng = 88172645463325252ULL;
+
+static double skew_rand(void) /* [-1, 1) */
+{
+    skew_rng ^= skew_rng << 13;
+    skew_rng ^= skew_rng >> 7;
+    skew_rng ^= skew_rng << 17;
+    return (double)(skew_rng >> 11) * 0x1p-53 * 2.0 - 1.0;
+}
+
+static void test_beam_skewed_camera(void **state)
+{
+    (void)state;
+    const unsigned L = 18;
+    const uint32_t n = 1u << L;
+    const double eye[3] = {0, 0, 0};
+    camera cam;
+    double worst = 0.0, dir[3] = {0, 0, 0};
+    for (int it = 0; it < 3000000; it++) {
+        const double f[3] = {skew_rand(), skew_rand(), skew_rand()};
+        const double s = 0.5 + 3.0 * fabs(skew_rand());
+        const double e = pow(10.0, -9.0 + 0.3 * fabs(skew_rand())) * s *
+                         sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        const double up[3] = {f[0] * s + e * skew_rand(), f[1] * s + e * skew_rand(),
+                              f[2] * s + e * skew_rand()};
+        camera c;
+        if (camera_init(&c, eye, f, up, 90.0, 2, 1) != CAMERA_OK)
+            continue;
+        const double rf = c.right[0] * c.forward[0] + c.right[1] * c.forward[1] +
+                          c.right[2] * c.forward[2];
+        double d[3];
+        camera_ray(&c, 1, 0, d);
+        if (rf > worst && d[0] < -0.3 && d[1] < -0.3 && d[2] < -0.3) {
+            worst = rf;
+            cam = c;
+            memcpy(dir, d, sizeof dir);
+        }
+    }
+    assert_true(worst > 1e-8); /* skewed indeed */
+    const uint32_t one[1][3] = {{n / 2 - 1, n / 2 - 1, n / 2 - 1}};
+    const double nrm[3] = {1, 1, 1};
+    const uint32_t rec = oct_voxel_pack(nrm, 0.0);
+    unsigned long hits = 0;
+    for (int k = 0; k < 4000; k++) {
+        const double s = 300000.0 + k * 0.00731;
+        double origin[3];
+        for (int a = 0; a < 3; a++) /* the ray passes 1e-5 voxel inside the voxel's corner */
+            origin[a] = eye[a] + dir[a] * s - (n / 2 - 1e-5);
+        oct_tree *t = tree_util_build(L, origin, (double)n, one, 1, &rec, NULL, 1, NULL);
+        assert_non_null(t);
+        for (int refine = 0; refine <= 1; refine++) {
+            uint8_t rgb[2][6], nb[2][6];
+            float depth[2][2];
+            frame_stats st[2];
+            for (int b = 0; b < 2; b++) { /* the default split, K = L */
+                frame_job job;
+                memset(&job, 0, sizeof job);
+                job.tree = t;
+                job.cam = &cam;
+                job.opts.split = L;
+                job.opts.refine = refine;
+                job.shade.ambient = 0.2f;
+                shade_default_light(&cam, job.shade.light);
+                job.rgb = rgb[b];
+                job.depth = depth[b];
+                job.normals = nb[b];
+                job.threads = 1;
+                job.beam_size = b ? 32 : 0;
+                assert_int_equal(frame_render(&job, &st[b]), 0);
+            }
+            hits += st[0].hits;
+            assert_memory_equal(depth[0], depth[1], sizeof depth[0]);
+            assert_memory_equal(rgb[0], rgb[1], sizeof rgb[0]);
+            assert_memory_equal(nb[0], nb[1], sizeof nb[0]);
+        }
+        tree_util_free(t);
+    }
+    print_message("skewed camera: R.F = %.3g, %lu hits, beam and whole rays the same\n", worst,
+                  hits);
+    assert_true(hits > 1000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_beam_same_image),
         cmocka_unit_test(test_beam_far_from_origin),
+        cmocka_unit_test(test_beam_skewed_camera),
         cmocka_unit_test(test_degenerate_cameras_no_nan),
         cmocka_unit_test(test_srgb_table_exact),
     };
