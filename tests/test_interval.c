@@ -348,6 +348,45 @@ static void test_pitfalls(void **state)
     assert_true(interval_is_nan(r) && f);
 }
 
+/* interval_exp rounds each end by two steps of interval_next_down and
+ * interval_next_up (widened to 0 and DBL_MIN below DBL_MIN), bit for bit,
+ * its shortcut for ends far from the limits of the range included: random
+ * boxes and the binades around those limits. */
+static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+static void check_exp_rounding(interval a)
+{
+    unsigned f = 0;
+    interval r = interval_exp(a, &f);
+    double l = interval_next_down(interval_next_down(exp(a.lo)));
+    double h = interval_next_up(interval_next_up(exp(a.hi)));
+    if (l < DBL_MIN)
+        l = 0.0;
+    if (h < DBL_MIN)
+        h = DBL_MIN;
+    if (!same_bits(r.lo, l) || !same_bits(r.hi, h) || f)
+        fail_msg("exp [%a, %a]: [%a, %a], expected [%a, %a]", a.lo, a.hi, r.lo, r.hi, l, h);
+}
+
+static void test_exp_rounding(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 100000; i++) {
+        interval a = rand_interval();
+        if (!interval_is_nan(a))
+            check_exp_rounding(a);
+    }
+    static const double edges[] = {-745.2, -745.1, -708.4, -708.39, -707.7, -707.6, 0.0,
+                                   709.0, 709.7, 709.78, 709.79, 710.0};
+    for (size_t e = 0; e < sizeof edges / sizeof edges[0]; e++)
+        for (int i = 0; i < 2000; i++) {
+            double x = edges[e] + (unit() - 0.5) * 0.02;
+            interval a = {x, x};
+            check_exp_rounding(a);
+        }
+    check_exp_rounding((interval){-INFINITY, INFINITY});
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -360,6 +399,7 @@ int main(void)
         cmocka_unit_test(test_sound_tan), cmocka_unit_test(test_sound_min),
         cmocka_unit_test(test_sound_max), cmocka_unit_test(test_sound_powc),
         cmocka_unit_test(test_point_box_width), cmocka_unit_test(test_pitfalls),
+        cmocka_unit_test(test_exp_rounding),
     };
     return cmocka_run_group_tests(tests, mpfr_setup, mpfr_teardown);
 }
