@@ -79,12 +79,24 @@ static inline double interval_next_up(double x)
         return x < 0.0 ? 0.0 : 0x1p-1022;
     uint64_t u;
     memcpy(&u, &x, sizeof u);
-    u = u >> 63 ? u - 1 : u + 1; /* away from 0 when positive, towards it when negative */
+    u += 1 - ((u >> 63) << 1); /* away from 0 when positive, towards it when negative */
     memcpy(&x, &u, sizeof x);
     return x;
 }
-/* At least nextafter(x, -inf) (see interval_next_up). */
-static inline double interval_next_down(double x) { return -interval_next_up(-x); }
+/* At least nextafter(x, -inf): -interval_next_up(-x), bit for bit (NaN
+ * included), without the two negations. */
+static inline double interval_next_down(double x)
+{
+    if (!(x > -INFINITY)) /* NaN or -inf */
+        return x;
+    if (fabs(x) < 0x1p-1022)
+        return x > 0.0 ? -0.0 : -0x1p-1022;
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u -= 1 - ((u >> 63) << 1); /* towards 0 when positive, away from it when negative */
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
 
 /* interval_next_up and _down for a finite x: the same result, one test fewer. */
 static inline double interval__up_finite(double x)
@@ -93,11 +105,20 @@ static inline double interval__up_finite(double x)
         return x < 0.0 ? 0.0 : 0x1p-1022;
     uint64_t u;
     memcpy(&u, &x, sizeof u);
-    u = u >> 63 ? u - 1 : u + 1;
+    u += 1 - ((u >> 63) << 1);
     memcpy(&x, &u, sizeof x);
     return x;
 }
-static inline double interval__down_finite(double x) { return -interval__up_finite(-x); }
+static inline double interval__down_finite(double x)
+{
+    if (fabs(x) < 0x1p-1022)
+        return x > 0.0 ? -0.0 : -0x1p-1022;
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u -= 1 - ((u >> 63) << 1);
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
 
 /* Internal helpers (double underscore): not for use outside interval.[ch]. */
 static inline double interval__min2(double a, double b) { return a < b ? a : b; } /* no NaN */

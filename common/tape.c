@@ -698,7 +698,7 @@ static int is_finite(interval a) { return (a.lo - a.lo) + (a.hi - a.hi) == 0.0; 
 /* interval_mul for the partials: those of a term without that variable are
  * [0, 0], and [0, 0] times a finite interval is [+0, +0] in interval_mul
  * (its all-finite path, no flag), here without the products. */
-static interval dmul(interval a, interval b, unsigned *f)
+INTERVAL_INLINE interval dmul(interval a, interval b, unsigned *f)
 {
     if ((is_zero(a) && is_finite(b)) || (is_zero(b) && is_finite(a))) {
         interval z = {0.0, 0.0};

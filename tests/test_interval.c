@@ -354,6 +354,47 @@ static void test_pitfalls(void **state)
  * boxes and the binades around those limits. */
 static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
+/* The rounding steps: interval_next_up is nextafter towards +inf on the
+ * normal numbers and -inf, keeps NaN and +inf, and takes zero and the
+ * subnormals to 0 or DBL_MIN; interval_next_down is -interval_next_up(-x),
+ * bit for bit, and the _finite forms agree with both on finite x. */
+static double up_reference(double x)
+{
+    if (isnan(x) || x == INFINITY)
+        return x;
+    if (fabs(x) < DBL_MIN)
+        return x < 0.0 ? 0.0 : DBL_MIN;
+    return nextafter(x, INFINITY);
+}
+
+static void check_steps(double x)
+{
+    double up = interval_next_up(x), down = interval_next_down(x);
+    if (!same_bits(up, up_reference(x)) || !same_bits(down, -up_reference(-x)))
+        fail_msg("steps of %a: up %a down %a", x, up, down);
+    if (isfinite(x) && (!same_bits(interval__up_finite(x), up) ||
+                        !same_bits(interval__down_finite(x), down)))
+        fail_msg("finite steps of %a", x);
+}
+
+static void test_rounding_steps(void **state)
+{
+    (void)state;
+    static const double sp[] = {0.0, -0.0, DBL_MIN, -DBL_MIN, 0x1p-1074, -0x1p-1074,
+                                0x1.fffffffffffffp-1023, -0x1.fffffffffffffp-1023, DBL_MAX,
+                                -DBL_MAX, INFINITY, -INFINITY, NAN, -NAN, 1.0, -1.0};
+    for (size_t i = 0; i < sizeof sp / sizeof sp[0]; i++)
+        check_steps(sp[i]);
+    for (int i = 0; i < 200000; i++) {
+        uint64_t u = next_u64();
+        double x;
+        memcpy(&x, &u, sizeof x);
+        check_steps(x);
+        check_steps(rand_value());
+    }
+}
+
+
 static void check_exp_rounding(interval a)
 {
     unsigned f = 0;
@@ -399,7 +440,7 @@ int main(void)
         cmocka_unit_test(test_sound_tan), cmocka_unit_test(test_sound_min),
         cmocka_unit_test(test_sound_max), cmocka_unit_test(test_sound_powc),
         cmocka_unit_test(test_point_box_width), cmocka_unit_test(test_pitfalls),
-        cmocka_unit_test(test_exp_rounding),
+        cmocka_unit_test(test_exp_rounding), cmocka_unit_test(test_rounding_steps),
     };
     return cmocka_run_group_tests(tests, mpfr_setup, mpfr_teardown);
 }
