@@ -706,7 +706,6 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     if (retest)
         leaf_centres(wk, depth, ok, T, &cb);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
-        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
         const interval *box = cb.box[i];
         const double *centre = cb.centre[i];
         unsigned n = 0;
@@ -743,8 +742,13 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
             surf[np] = (uint8_t)voxel_surface(wk, cidx, centre, &nw[np]);
             np++;
             mask |= (uint8_t)(1u << i);
-        } else if (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc)) {
-            mask |= (uint8_t)(1u << i);
+        } else if (depth + 1 == c->levels) {
+            if (emit_voxel(wk, box, centre))
+                mask |= (uint8_t)(1u << i);
+        } else { /* the child's coordinates, for the few children that go on */
+            uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
+            if (visit_node(wk, depth + 1, cc))
+                mask |= (uint8_t)(1u << i);
         }
     }
     if (np)

@@ -395,6 +395,34 @@ static void test_rounding_steps(void **state)
 }
 
 
+/* interval_add on finite sums: each end stepped outward by
+ * interval__down_finite / interval__up_finite unless it is an exact zero
+ * (x == -y), bit for bit, on random boxes, tiny ends and cancellations. */
+static void test_add_rounding(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 200000; i++) {
+        interval a = rand_interval(), b = rand_interval();
+        if (i % 4 == 0) /* exact cancellation */
+            b = interval_neg(a);
+        if (i % 8 == 1) { /* ends near DBL_MIN */
+            a.lo = ldexp(1.0 + unit(), -1022 - (int)(next_u64() % 3));
+            a.hi = a.lo;
+            b.lo = b.hi = -ldexp(1.0 + unit(), -1022 - (int)(next_u64() % 3));
+        }
+        double lo = a.lo + b.lo, hi = a.hi + b.hi;
+        if (!(lo - lo == 0.0 && hi - hi == 0.0))
+            continue;
+        unsigned f = 0;
+        interval r = interval_add(a, b, &f);
+        double el = lo == 0.0 && a.lo == -b.lo ? lo : interval__down_finite(lo);
+        double eh = hi == 0.0 && a.hi == -b.hi ? hi : interval__up_finite(hi);
+        if (!same_bits(r.lo, el) || !same_bits(r.hi, eh) || f)
+            fail_msg("[%a, %a] + [%a, %a]: [%a, %a], expected [%a, %a]", a.lo, a.hi, b.lo, b.hi,
+                     r.lo, r.hi, el, eh);
+    }
+}
+
 static void check_exp_rounding(interval a)
 {
     unsigned f = 0;
@@ -441,6 +469,7 @@ int main(void)
         cmocka_unit_test(test_sound_max), cmocka_unit_test(test_sound_powc),
         cmocka_unit_test(test_point_box_width), cmocka_unit_test(test_pitfalls),
         cmocka_unit_test(test_exp_rounding), cmocka_unit_test(test_rounding_steps),
+        cmocka_unit_test(test_add_rounding),
     };
     return cmocka_run_group_tests(tests, mpfr_setup, mpfr_teardown);
 }
