@@ -79,12 +79,24 @@ static inline double interval_next_up(double x)
         return x < 0.0 ? 0.0 : 0x1p-1022;
     uint64_t u;
     memcpy(&u, &x, sizeof u);
-    u = u >> 63 ? u - 1 : u + 1; /* away from 0 when positive, towards it when negative */
+    u += 1 - ((u >> 63) << 1); /* away from 0 when positive, towards it when negative */
     memcpy(&x, &u, sizeof x);
     return x;
 }
-/* At least nextafter(x, -inf) (see interval_next_up). */
-static inline double interval_next_down(double x) { return -interval_next_up(-x); }
+/* At least nextafter(x, -inf): -interval_next_up(-x), bit for bit (NaN
+ * included), without the two negations. */
+static inline double interval_next_down(double x)
+{
+    if (!(x > -INFINITY)) /* NaN or -inf */
+        return x;
+    if (fabs(x) < 0x1p-1022)
+        return x > 0.0 ? -0.0 : -0x1p-1022;
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u -= 1 - ((u >> 63) << 1); /* towards 0 when positive, away from it when negative */
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
 
 /* interval_next_up and _down for a finite x: the same result, one test fewer. */
 static inline double interval__up_finite(double x)
@@ -93,11 +105,20 @@ static inline double interval__up_finite(double x)
         return x < 0.0 ? 0.0 : 0x1p-1022;
     uint64_t u;
     memcpy(&u, &x, sizeof u);
-    u = u >> 63 ? u - 1 : u + 1;
+    u += 1 - ((u >> 63) << 1);
     memcpy(&x, &u, sizeof x);
     return x;
 }
-static inline double interval__down_finite(double x) { return -interval__up_finite(-x); }
+static inline double interval__down_finite(double x)
+{
+    if (fabs(x) < 0x1p-1022)
+        return x > 0.0 ? -0.0 : -0x1p-1022;
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u -= 1 - ((u >> 63) << 1);
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
 
 /* Internal helpers (double underscore): not for use outside interval.[ch]. */
 static inline double interval__min2(double a, double b) { return a < b ? a : b; } /* no NaN */
@@ -128,14 +149,29 @@ static inline interval interval_hull(interval a, interval b)
 
 static inline interval interval_neg(interval a) { return interval__mk(-a.hi, -a.lo); }
 
+/* The ends of a finite sum s = x + y, rounded outward as interval_add
+ * rounds them: an end of at least DBL_MIN in magnitude is not 0, so only
+ * the bit step is tested for there. */
+static inline double interval__sum_down(double s, double x, double y)
+{
+    if (fabs(s) >= 0x1p-1022)
+        return interval__down_finite(s);
+    return s == 0.0 && x == -y ? s : interval__down_finite(s);
+}
+static inline double interval__sum_up(double s, double x, double y)
+{
+    if (fabs(s) >= 0x1p-1022)
+        return interval__up_finite(s);
+    return s == 0.0 && x == -y ? s : interval__up_finite(s);
+}
+
 INTERVAL_INLINE interval interval_add(interval a, interval b, unsigned *flags)
 {
     double flo = a.lo + b.lo, fhi = a.hi + b.hi;
     /* Fast path, same result: finite sums come from finite operands only
      * (inf + x is inf or NaN), and then no flag can be raised. */
     if (flo - flo == 0.0 && fhi - fhi == 0.0)
-        return interval__mk(flo == 0.0 && a.lo == -b.lo ? flo : interval__down_finite(flo),
-                            fhi == 0.0 && a.hi == -b.hi ? fhi : interval__up_finite(fhi));
+        return interval__mk(interval__sum_down(flo, a.lo, b.lo), interval__sum_up(fhi, a.hi, b.hi));
     if (interval__isnan(a) || interval__isnan(b))
         return interval__nan_flag(flags);
     /* Infinite ends are points of the box (an overflowed value), so

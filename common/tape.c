@@ -692,11 +692,26 @@ interval tape_eval_interval(const tape *t, const interval box[3], interval *s, u
     return s[t->root];
 }
 
+static int is_zero(interval a) { return a.lo == 0.0 && a.hi == 0.0; }
+static int is_finite(interval a) { return (a.lo - a.lo) + (a.hi - a.hi) == 0.0; }
+
+/* interval_mul for the partials: those of a term without that variable are
+ * [0, 0], and [0, 0] times a finite interval is [+0, +0] in interval_mul
+ * (its all-finite path, no flag), here without the products. */
+INTERVAL_INLINE interval dmul(interval a, interval b, unsigned *f)
+{
+    if ((is_zero(a) && is_finite(b)) || (is_zero(b) && is_finite(a))) {
+        interval z = {0.0, 0.0};
+        return z;
+    }
+    return interval_mul(a, b, f);
+}
+
 /* r->d[j] = a->d[j] * m for an interval multiplier m. */
 static void iscale(tape_idual *r, const tape_idual *a, interval v, interval m, unsigned *f)
 {
     for (int j = 0; j < 3; j++)
-        r->d[j] = interval_mul(a->d[j], m, f);
+        r->d[j] = dmul(a->d[j], m, f);
     r->v = v;
 }
 
@@ -785,14 +800,13 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
                 break;
             }
             for (int j = 0; j < 3; j++)
-                r->d[j] = interval_add(interval_mul(a->d[j], c->v, &f),
-                                       interval_mul(a->v, c->d[j], &f), &f);
+                r->d[j] = interval_add(dmul(a->d[j], c->v, &f), dmul(a->v, c->d[j], &f), &f);
             r->v = interval_mul(a->v, c->v, &f);
             break;
         case TAPE_DIV: {
             interval v = interval_div(a->v, c->v, &f);
             for (int j = 0; j < 3; j++)
-                r->d[j] = interval_div(interval_sub(a->d[j], interval_mul(v, c->d[j], &f), &f),
+                r->d[j] = interval_div(interval_sub(a->d[j], dmul(v, c->d[j], &f), &f),
                                        c->v, &f);
             r->v = v;
             break;

@@ -34,6 +34,13 @@ static void fill(double *v, unsigned n)
 #undef W
 #undef FN
 #undef SCALE
+#define W 6
+#define FN eval6
+#define SCALE scale6
+#include "common/tape_lanes_body.h"
+#undef W
+#undef FN
+#undef SCALE
 #define W 8
 #define FN eval8
 #define SCALE scale8
@@ -47,6 +54,8 @@ void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[L], const do
         eval2(t, n, x, y, z, f, g, s);
     else if (n <= 4)
         eval4(t, n, x, y, z, f, g, s);
+    else if (n <= 6)
+        eval6(t, n, x, y, z, f, g, s);
     else
         eval8(t, n, x, y, z, f, g, s);
 }

@@ -348,6 +348,114 @@ static void test_pitfalls(void **state)
     assert_true(interval_is_nan(r) && f);
 }
 
+/* interval_exp rounds each end by two steps of interval_next_down and
+ * interval_next_up (widened to 0 and DBL_MIN below DBL_MIN), bit for bit,
+ * its shortcut for ends far from the limits of the range included: random
+ * boxes and the binades around those limits. */
+static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* The rounding steps: interval_next_up is nextafter towards +inf on the
+ * normal numbers and -inf, keeps NaN and +inf, and takes zero and the
+ * subnormals to 0 or DBL_MIN; interval_next_down is -interval_next_up(-x),
+ * bit for bit, and the _finite forms agree with both on finite x. */
+static double up_reference(double x)
+{
+    if (isnan(x) || x == INFINITY)
+        return x;
+    if (fabs(x) < DBL_MIN)
+        return x < 0.0 ? 0.0 : DBL_MIN;
+    return nextafter(x, INFINITY);
+}
+
+static void check_steps(double x)
+{
+    double up = interval_next_up(x), down = interval_next_down(x);
+    if (!same_bits(up, up_reference(x)) || !same_bits(down, -up_reference(-x)))
+        fail_msg("steps of %a: up %a down %a", x, up, down);
+    if (isfinite(x) && (!same_bits(interval__up_finite(x), up) ||
+                        !same_bits(interval__down_finite(x), down)))
+        fail_msg("finite steps of %a", x);
+}
+
+static void test_rounding_steps(void **state)
+{
+    (void)state;
+    static const double sp[] = {0.0, -0.0, DBL_MIN, -DBL_MIN, 0x1p-1074, -0x1p-1074,
+                                0x1.fffffffffffffp-1023, -0x1.fffffffffffffp-1023, DBL_MAX,
+                                -DBL_MAX, INFINITY, -INFINITY, NAN, -NAN, 1.0, -1.0};
+    for (size_t i = 0; i < sizeof sp / sizeof sp[0]; i++)
+        check_steps(sp[i]);
+    for (int i = 0; i < 200000; i++) {
+        uint64_t u = next_u64();
+        double x;
+        memcpy(&x, &u, sizeof x);
+        check_steps(x);
+        check_steps(rand_value());
+    }
+}
+
+
+/* interval_add on finite sums: each end stepped outward by
+ * interval__down_finite / interval__up_finite unless it is an exact zero
+ * (x == -y), bit for bit, on random boxes, tiny ends and cancellations. */
+static void test_add_rounding(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 200000; i++) {
+        interval a = rand_interval(), b = rand_interval();
+        if (i % 4 == 0) /* exact cancellation */
+            b = interval_neg(a);
+        if (i % 8 == 1) { /* ends near DBL_MIN */
+            a.lo = ldexp(1.0 + unit(), -1022 - (int)(next_u64() % 3));
+            a.hi = a.lo;
+            b.lo = b.hi = -ldexp(1.0 + unit(), -1022 - (int)(next_u64() % 3));
+        }
+        double lo = a.lo + b.lo, hi = a.hi + b.hi;
+        if (!(lo - lo == 0.0 && hi - hi == 0.0))
+            continue;
+        unsigned f = 0;
+        interval r = interval_add(a, b, &f);
+        double el = lo == 0.0 && a.lo == -b.lo ? lo : interval__down_finite(lo);
+        double eh = hi == 0.0 && a.hi == -b.hi ? hi : interval__up_finite(hi);
+        if (!same_bits(r.lo, el) || !same_bits(r.hi, eh) || f)
+            fail_msg("[%a, %a] + [%a, %a]: [%a, %a], expected [%a, %a]", a.lo, a.hi, b.lo, b.hi,
+                     r.lo, r.hi, el, eh);
+    }
+}
+
+static void check_exp_rounding(interval a)
+{
+    unsigned f = 0;
+    interval r = interval_exp(a, &f);
+    double l = interval_next_down(interval_next_down(exp(a.lo)));
+    double h = interval_next_up(interval_next_up(exp(a.hi)));
+    if (l < DBL_MIN)
+        l = 0.0;
+    if (h < DBL_MIN)
+        h = DBL_MIN;
+    if (!same_bits(r.lo, l) || !same_bits(r.hi, h) || f)
+        fail_msg("exp [%a, %a]: [%a, %a], expected [%a, %a]", a.lo, a.hi, r.lo, r.hi, l, h);
+}
+
+static void test_exp_rounding(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 100000; i++) {
+        interval a = rand_interval();
+        if (!interval_is_nan(a))
+            check_exp_rounding(a);
+    }
+    static const double edges[] = {-745.2, -745.1, -708.4, -708.39, -707.7, -707.6, 0.0,
+                                   709.0, 709.7, 709.78, 709.79, 710.0};
+    for (size_t e = 0; e < sizeof edges / sizeof edges[0]; e++)
+        for (int i = 0; i < 2000; i++) {
+            double x = edges[e] + (unit() - 0.5) * 0.02;
+            interval a = {x, x};
+            check_exp_rounding(a);
+        }
+    check_exp_rounding((interval){-INFINITY, INFINITY});
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -360,6 +468,8 @@ int main(void)
         cmocka_unit_test(test_sound_tan), cmocka_unit_test(test_sound_min),
         cmocka_unit_test(test_sound_max), cmocka_unit_test(test_sound_powc),
         cmocka_unit_test(test_point_box_width), cmocka_unit_test(test_pitfalls),
+        cmocka_unit_test(test_exp_rounding), cmocka_unit_test(test_rounding_steps),
+        cmocka_unit_test(test_add_rounding),
     };
     return cmocka_run_group_tests(tests, mpfr_setup, mpfr_teardown);
 }
