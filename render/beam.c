@@ -60,7 +60,7 @@ typedef struct beam_item {
     uint64_t node;  /* index in its depth */
     uint32_t cell[3];
     unsigned depth;
-    double dist;    /* its distance bound when it was pushed */
+    double dist;    /* its squared distance bound when it was pushed */
     beam_rect reach; /* the sub-blocks it may touch */
 } beam_item;
 
@@ -122,7 +122,7 @@ static inline double rect_bound(const double (*best)[BEAM_GRID], beam_rect r, in
 
 /* For every sub-block in `all`, the nearest (far = 0) or farthest (far = 1)
  * distance from the eye to an occupied cell of depth lim (1..levels) its
- * pyramid may touch, into best (set to +inf, or -inf, beforehand). One
+ * pyramid may touch, squared, into best (set to +inf, or -inf, beforehand). One
  * walk serves them all: children nearest first for the nearest (farthest
  * first for the farthest), and a cell is opened only while it may touch
  * some sub-block whose distance it could still beat: a best-first search
@@ -160,7 +160,7 @@ static void beam_extremes(const beam_walk *bw, int far, unsigned lim, beam_rect 
                 if (e > 0.0)
                     d2 += e * e;
             }
-            const double dist = sqrt(d2);
+            const double dist = d2; /* squared: monotone, and no sqrt on the way */
             if ((far ? dist <= it_bound : dist >= it_bound) || !pyramid_may_touch(&bw->p, ctr, h))
                 continue;
             beam_rect reach = it.reach;
@@ -284,7 +284,7 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
     for (unsigned r = 0; r < bw.rows; r++)
         for (unsigned c = 0; c < bw.cols; c++) {
             const double lo = best[r][c];
-            grid->t_lo[r][c] = lo < INFINITY ? t_down(lo, scale) : INFINITY;
+            grid->t_lo[r][c] = lo < INFINITY ? t_down(sqrt(lo), scale) : INFINITY;
             any |= lo < INFINITY;
         }
     if (!any)
@@ -294,7 +294,7 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
      * fewer opened cells (RENDER.md, "Beam"). */
     double far_best[1][BEAM_GRID] = {{-INFINITY}}; /* [0][0]: the whole block */
     beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, (beam_rect){0, 0, 0, 0}, far_best);
-    grid->t_hi = t_up(far_best[0][0], scale);
+    grid->t_hi = far_best[0][0] >= 0.0 ? t_up(sqrt(far_best[0][0]), scale) : INFINITY;
     return 1;
 }
 

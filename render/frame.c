@@ -163,11 +163,14 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
             for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++) {
                 const double v = camera_v(cam, j);
                 for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++) {
+                    if (empty) { /* a miss needs no direction */
+                        render_pixel(job, i, j, cam->forward, NULL, NULL, hits, steps);
+                        continue;
+                    }
                     double dir[3];
                     camera_ray_uv(cam, us[i - us0], v, dir);
                     trace_ray r;
-                    const int traced = !empty && trace_setup_eye(eye, dir, &r) &&
-                                       trace_clip(&r, t_lo, g.t_hi);
+                    const int traced = trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, g.t_hi);
                     render_pixel(job, i, j, dir, traced ? &r : NULL, &an, hits, steps);
                 }
             }
