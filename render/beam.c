@@ -1,4 +1,4 @@
-/* beam: the windows of ray parameter a pixel block's rays need (see beam.h). */
+/* beam: where a pixel block's rays can start (see beam.h). */
 #include "render/beam.h"
 
 #include <math.h>
@@ -60,7 +60,7 @@ typedef struct beam_item {
     uint64_t node;  /* index in its depth */
     uint32_t cell[3];
     unsigned depth;
-    double dist;    /* its squared distance bound when it was pushed */
+    double dist;    /* its squared distance when it was pushed */
     beam_rect reach; /* the sub-blocks it may touch */
 } beam_item;
 
@@ -108,47 +108,46 @@ static void rect_touch(const beam_walk *bw, const double c[3], double h, beam_re
 
 /* The bound a cell must beat to be worth opening for the sub-blocks in r:
  * the largest of their nearest distances so far (a nearer cell improves at
- * least one of them), or the smallest of their farthest. */
-static inline double rect_bound(const double (*best)[BEAM_GRID], beam_rect r, int far)
+ * least one of them). */
+static inline double rect_bound(const double (*best)[BEAM_GRID], beam_rect r)
 {
     if (r.c0 == r.c1 && r.r0 == r.r1) /* deep cells reach one sub-block */
         return best[r.r0][r.c0];
-    double b = far ? INFINITY : -INFINITY;
+    double b = -INFINITY;
     for (unsigned y = r.r0; y <= r.r1; y++)
         for (unsigned x = r.c0; x <= r.c1; x++)
-            b = far ? (best[y][x] < b ? best[y][x] : b) : (best[y][x] > b ? best[y][x] : b);
+            b = best[y][x] > b ? best[y][x] : b;
     return b;
 }
 
-/* For every sub-block in `all`, the nearest (far = 0) or farthest (far = 1)
- * distance from the eye to an occupied cell of depth lim (1..levels) its
- * pyramid may touch, squared, into best (set to +inf, or -inf, beforehand). One
- * walk serves them all: children nearest first for the nearest (farthest
- * first for the farthest), and a cell is opened only while it may touch
- * some sub-block whose distance it could still beat: a best-first search
- * along the front (or back) of the surface, not a sweep of the pyramid, with
- * the way down to the surface shared and only the last levels parting. */
-static void beam_extremes(const beam_walk *bw, int far, unsigned lim, beam_rect all,
-                          double (*best)[BEAM_GRID])
+/* For every sub-block in `all`, the squared distance from the eye to the
+ * nearest voxel its pyramid may touch, into best (+inf beforehand, and
+ * where there is none). One walk serves them all: children nearest the eye
+ * first, and a cell opened only while it may touch some sub-block whose
+ * distance it could still beat: a best-first search along the front of the
+ * surface, not a sweep of the pyramid, with the way down to the surface
+ * shared and only the last levels parting. Squared distances order as the
+ * distances do, without a square root a cell. */
+static void beam_nearest(const beam_walk *bw, beam_rect all, double (*best)[BEAM_GRID])
 {
     const oct_tree *tree = bw->tree;
+    const unsigned levels = tree->levels;
     const double *o = bw->o;
     beam_item stack[8 * OCT_MAX_LEVELS + 1];
     unsigned sp = 0;
-    stack[sp++] = (beam_item){0, {0, 0, 0}, 0, far ? INFINITY : 0.0, all};
-    const unsigned order = bw->flip ^ (far ? 7u : 0u);
+    stack[sp++] = (beam_item){0, {0, 0, 0}, 0, 0.0, all};
     while (sp) {
         const beam_item it = stack[--sp];
-        const double it_bound = rect_bound(best, it.reach, far);
-        if (far ? it.dist <= it_bound : it.dist >= it_bound)
+        const double it_bound = rect_bound(best, it.reach);
+        if (it.dist >= it_bound)
             continue; /* the distances improved since it was pushed */
         const oct_group *g = &tree->groups[it.depth][it.node >> 3];
         const unsigned mask = g->mask[it.node & 7u];
-        const double s = (double)(UINT32_C(1) << (tree->levels - it.depth - 1)); /* child edge */
+        const double s = (double)(UINT32_C(1) << (levels - it.depth - 1)); /* child edge */
         const double h = 0.5 * s + bw->margin;
         /* pushed in reverse order: the child to look at first is popped first */
         for (int k = 7; k >= 0; k--) {
-            const unsigned c = (unsigned)k ^ order;
+            const unsigned c = (unsigned)k ^ bw->flip;
             if (!(mask >> c & 1u))
                 continue;
             uint32_t cell[3];
@@ -156,30 +155,26 @@ static void beam_extremes(const beam_walk *bw, int far, unsigned lim, beam_rect 
             for (int i = 0; i < 3; i++) {
                 cell[i] = 2u * it.cell[i] + (c >> i & 1u);
                 ctr[i] = ((double)cell[i] + 0.5) * s - o[i]; /* one rounding */
-                const double e = far ? fabs(ctr[i]) + h : fabs(ctr[i]) - h;
+                const double e = fabs(ctr[i]) - h;
                 if (e > 0.0)
                     d2 += e * e;
             }
-            const double dist = d2; /* squared: monotone, and no sqrt on the way */
-            if ((far ? dist <= it_bound : dist >= it_bound) || !pyramid_may_touch(&bw->p, ctr, h))
+            if (d2 >= it_bound || !pyramid_may_touch(&bw->p, ctr, h))
                 continue;
             beam_rect reach = it.reach;
             if (reach.c0 != reach.c1 || reach.r0 != reach.r1) {
                 rect_touch(bw, ctr, h, &reach);
-                const double bound = rect_bound(best, reach, far);
-                if (far ? dist <= bound : dist >= bound)
+                if (d2 >= rect_bound(best, reach))
                     continue;
             }
-            if (it.depth + 1 == lim) {
+            if (it.depth + 1 == levels) {
                 for (unsigned y = reach.r0; y <= reach.r1; y++)
-                    for (unsigned x = reach.c0; x <= reach.c1; x++) {
-                        double *b = &best[y][x];
-                        *b = (far ? dist > *b : dist < *b) ? dist : *b;
-                    }
+                    for (unsigned x = reach.c0; x <= reach.c1; x++)
+                        best[y][x] = d2 < best[y][x] ? d2 : best[y][x];
                 continue;
             }
             stack[sp++] = (beam_item){oct_child_index(tree->groups[it.depth], it.node, c),
-                                      {cell[0], cell[1], cell[2]}, it.depth + 1, dist, reach};
+                                      {cell[0], cell[1], cell[2]}, it.depth + 1, d2, reach};
         }
     }
 }
@@ -207,10 +202,9 @@ static double basis_slack(const camera *cam, double umax, double vmax)
     return 4.0 * e * g * g;
 }
 
-/* Grid distance -> the caller's t (unit directions), widened outward by a
+/* Grid distance -> the caller's t (unit directions), widened downward by a
  * relative 2^-40 for the division and a direction's length of 1 +- ulps. */
 static double t_down(double dist, double scale) { return dist / scale * (1.0 - 0x1p-40); }
-static double t_up(double dist, double scale) { return dist / scale * (1.0 + 0x1p-40); }
 
 /* Sub-block boundaries: `n` near-equal parts of [a, b). */
 static unsigned grid_split(uint32_t a, uint32_t b, uint32_t *at)
@@ -222,7 +216,7 @@ static unsigned grid_split(uint32_t a, uint32_t b, uint32_t *at)
     return n;
 }
 
-int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
+int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
                  uint32_t j1, beam_grid *grid)
 {
     const unsigned levels = tree->levels;
@@ -278,8 +272,7 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
     for (unsigned r = 0; r < BEAM_GRID; r++)
         for (unsigned c = 0; c < BEAM_GRID; c++)
             best[r][c] = INFINITY;
-    beam_extremes(&bw, 0, levels,
-                  (beam_rect){0, (uint8_t)(bw.cols - 1), 0, (uint8_t)(bw.rows - 1)}, best);
+    beam_nearest(&bw, (beam_rect){0, (uint8_t)(bw.cols - 1), 0, (uint8_t)(bw.rows - 1)}, best);
     int any = 0;
     for (unsigned r = 0; r < bw.rows; r++)
         for (unsigned c = 0; c < bw.cols; c++) {
@@ -289,12 +282,6 @@ int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t 
         }
     if (!any)
         return 0;
-    /* The far end, for the whole block, only stops rays that miss: the
-     * voxels' parents of depth L - 3 bound it a few voxels later for far
-     * fewer opened cells (RENDER.md, "Beam"). */
-    double far_best[1][BEAM_GRID] = {{-INFINITY}}; /* [0][0]: the whole block */
-    beam_extremes(&bw, 1, levels > 3 ? levels - 3 : 1, (beam_rect){0, 0, 0, 0}, far_best);
-    grid->t_hi = far_best[0][0] >= 0.0 ? t_up(sqrt(far_best[0][0]), scale) : INFINITY;
     return 1;
 }
 

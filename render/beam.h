@@ -2,10 +2,9 @@
  * a block of pixels all lie in one pyramid with its apex at the eye, and
  * those of each of its sub-blocks in a smaller one. One walk of the octree
  * finds, for every sub-block, the nearest distance at which its pyramid may
- * touch an occupied voxel, and for the block the farthest: outside
- * [t_lo(sub-block), t_hi] no ray can meet an occupied voxel. The frame then
- * traces each ray inside its window only (trace_clip); a sub-block, or a
- * block, whose pyramid touches nothing costs no ray at all.
+ * touch an occupied voxel: before that t_lo no ray of the sub-block can meet
+ * one. The frame then traces each ray from its t_lo only (trace_clip); a
+ * sub-block, or a block, whose pyramid touches nothing costs no ray at all.
  *
  * Exactness. The test is conservative: a cell is rejected only when one of
  * the bounding half-spaces (four sides through the eye, one "in front of the
@@ -17,7 +16,7 @@
  * rounding is ulp(max(|eye|, N)) voxels whatever the cube's origin; the
  * margin is 2^-12 voxel plus 2^-40 of that magnitude. The distances are
  * widened too. A unit ray at parameter t is at distance t from the eye, so
- * it can be in an occupied voxel only inside its window: traced inside it,
+ * it can be in an occupied voxel only after its t_lo: traced from there,
  * a ray meets the same voxels at the same plane times as traced whole, and
  * the image is the same (tests/test_frame.c compares the two, byte for
  * byte). */
@@ -34,18 +33,16 @@ typedef struct beam_grid {
     uint32_t col[BEAM_GRID + 1]; /* sub-block column c: pixels [col[c], col[c + 1]) */
     uint32_t row[BEAM_GRID + 1];
     double t_lo[BEAM_GRID][BEAM_GRID]; /* [row][column]; +inf: none of its rays meets a voxel */
-    double t_hi;                       /* the whole block's */
 } beam_grid;
 
 /* Splits the pixel block [i0, i1) x [j0, j1) (non-empty) into up to
  * BEAM_GRID x BEAM_GRID sub-blocks and returns 1 with, for each, the t
  * (caller's t along unit rays from cam->eye) before which none of its rays
- * can meet an occupied voxel, and for the block the t after which none
- * can; returns 0 when no ray of the block can meet one. The starts come
- * from the voxels themselves, found for all sub-blocks in one walk; t_hi
- * from the voxels' ancestors of depth L - 3 (RENDER.md, "Beam"). Reads the
- * tree only; no allocation. */
-int beam_windows(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
+ * can meet an occupied voxel; returns 0 when no ray of the block can meet
+ * one. The starts come from the voxels themselves, found for all
+ * sub-blocks in one walk (RENDER.md, "Beam"). Reads the tree only; no
+ * allocation. */
+int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
                  uint32_t j1, beam_grid *grid);
 
 /* A box (grid units) holding the point at distance t (the caller's t along

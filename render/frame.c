@@ -106,7 +106,7 @@ static inline void render_pixel(const frame_job *job, uint32_t i, uint32_t j, co
 }
 
 /* The pixels [i0, i1) x [j0, j1): with the beam, each sub-block's rays are
- * traced inside its window only, from its anchor, and none at all when its
+ * traced from its start only, from its anchor, and none at all when its
  * pyramid touches no occupied cell. */
 static void render_block(const frame_job *job, const trace_eye *eye, const double *us, uint32_t us0,
                          uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1, uint64_t *hits,
@@ -116,7 +116,7 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
     beam_grid g;
     int any = 1;
     if (job->beam_size) {
-        any = beam_windows(job->tree, cam, i0, i1, j0, j1, &g);
+        any = beam_starts(job->tree, cam, i0, i1, j0, j1, &g);
     } else { /* one sub-block, the whole ray */
         g.cols = g.rows = 1;
         g.col[0] = i0;
@@ -124,7 +124,6 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
         g.row[0] = j0;
         g.row[1] = j1;
         g.t_lo[0][0] = 0.0;
-        g.t_hi = INFINITY;
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
         render_pixel(job, i0, j0, cam->forward, NULL, NULL, hits, steps);
@@ -170,7 +169,7 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
                     double dir[3];
                     camera_ray_uv(cam, us[i - us0], v, dir);
                     trace_ray r;
-                    const int traced = trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, g.t_hi);
+                    const int traced = trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY);
                     render_pixel(job, i, j, dir, traced ? &r : NULL, &an, hits, steps);
                 }
             }

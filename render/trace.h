@@ -99,8 +99,9 @@ int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r);
 /* Restricts a prepared ray to the caller's t in [t_lo, t_hi]: the traversal
  * starts in the cell the ray is in at t_lo (chosen by the tie rule, as if it
  * had walked there) and stops at t_hi. When no occupied voxel meets the ray
- * outside [t_lo, t_hi] (what beam_windows guarantees), the hit, its voxel and
- * its t are those of the whole ray, bit for bit; only the step count falls.
+ * outside [t_lo, t_hi] (what beam_starts guarantees for [t_lo, +inf)), the
+ * hit, its voxel and its t are those of the whole ray, bit for bit; only the
+ * step count falls.
  * Returns 0 when nothing of the ray is left (then it must not be traced). */
 int trace_clip(trace_ray *r, double t_lo, double t_hi);
 
