@@ -150,10 +150,11 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
             const double t_lo = g.t_lo[sr][sc];
             const int empty = !(t_lo < INFINITY); /* every ray of the sub-block misses */
             /* the sub-block's rays all start at t_lo: where they do, the
-             * descent from the root is shared */
+             * descent from the root is shared (not with --beam 0: rays
+             * traced whole, the reference the beam is tested against) */
             trace_anchor an;
             an.depth = 0;
-            if (!empty && eye->ok) {
+            if (!empty && eye->ok && job->beam_size) {
                 double lo[3], hi[3];
                 beam_start_box(cam, eye->o, eye->scale, g.col[sc], g.col[sc + 1], g.row[sr],
                                g.row[sr + 1], t_lo, lo, hi);
@@ -169,7 +170,8 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
                     double dir[3];
                     camera_ray_uv(cam, us[i - us0], v, dir);
                     trace_ray r;
-                    const int traced = trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY);
+                    const int traced =
+                        trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY);
                     render_pixel(job, i, j, dir, traced ? &r : NULL, &an, hits, steps);
                 }
             }

@@ -428,8 +428,8 @@ static int trace_ray_run(const oct_tree *tree, const trace_opts *opts, const tra
         } else {
             if (d > split && d < levels) {
                 /* step two, below K: walk the empty cell voxel by voxel */
-                steps = trace_walk_empty(V, size, TC, Txy, Tzw, ZOxy, ZOzw, ZIxy, ZIzw, zo[2], zi[2],
-                                         far, steps, max_steps);
+                steps = trace_walk_empty(V, size, TC, Txy, Tzw, ZOxy, ZOzw, ZIxy, ZIzw, zo[2],
+                                         zi[2], far, steps, max_steps);
                 if (steps > max_steps)
                     goto out;
             }

@@ -580,7 +580,8 @@ static void test_anchored_same_hit(void **state)
             }
             trace_ray rays[6];
             int nr = 0;
-            double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            double lo[3] = {INFINITY, INFINITY, INFINITY};
+            double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
             for (int k = 0; k < group_size; k++) {
                 double dir[3];
                 for (int a = 0; a < 3; a++)
