@@ -217,7 +217,7 @@ static unsigned grid_split(uint32_t a, uint32_t b, uint32_t *at)
 }
 
 int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
-                 uint32_t j1, beam_grid *grid)
+                uint32_t j1, beam_grid *grid)
 {
     const unsigned levels = tree->levels;
     grid->cols = grid_split(i0, i1, grid->col);
@@ -280,9 +280,7 @@ int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i
             grid->t_lo[r][c] = lo < INFINITY ? t_down(sqrt(lo), scale) : INFINITY;
             any |= lo < INFINITY;
         }
-    if (!any)
-        return 0;
-    return 1;
+    return any;
 }
 
 void beam_start_box(const camera *cam, const double o[3], double scale, uint32_t i0, uint32_t i1,

@@ -43,7 +43,7 @@ typedef struct beam_grid {
  * sub-blocks in one walk (RENDER.md, "Beam"). Reads the tree only; no
  * allocation. */
 int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
-                 uint32_t j1, beam_grid *grid);
+                uint32_t j1, beam_grid *grid);
 
 /* A box (grid units) holding the point at distance t (the caller's t along
  * unit rays) of every ray through the pixel centres [i0, i1) x [j0, j1)
