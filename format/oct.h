@@ -94,19 +94,6 @@ static inline uint8_t oct_node_mask(const oct_group *g, uint64_t node)
     return g[node >> 3].mask[node & 7];
 }
 
-/* Index, in the next depth (or the voxel array), of child `child` (0..7) of
- * `node`. Only meaningful when that child's bit is set. */
-static inline uint64_t oct_child_index(const oct_group *g, uint64_t node, unsigned child)
-{
-    const oct_group *gr = &g[node >> 3];
-    unsigned k = (unsigned)(node & 7);
-    uint64_t masks;
-    memcpy(&masks, gr->mask, 8); /* little-endian host: mask[j] is byte j */
-    uint64_t before = masks & ((UINT64_C(1) << (8 * k)) - 1); /* k < 8: no UB */
-    unsigned within = (unsigned)gr->mask[k] & ((1u << child) - 1u);
-    return gr->base + oct_popcount64(before) + oct_popcount64(within);
-}
-
 /* The child mask of `node` and the index, in the next depth (or the voxel
  * array), of its first child: what a traversal keeps of a node it enters. */
 typedef struct oct_children {
@@ -124,6 +111,14 @@ static inline oct_children oct_node_children(const oct_group *g, uint64_t node)
     c.mask = (uint32_t)(masks >> (8 * k)) & 0xffu;
     c.first = gr->base + oct_popcount64(masks & ((UINT64_C(1) << (8 * k)) - 1)); /* k < 8 */
     return c;
+}
+
+/* Index, in the next depth (or the voxel array), of child `child` (0..7) of
+ * `node`. Only meaningful when that child's bit is set. */
+static inline uint64_t oct_child_index(const oct_group *g, uint64_t node, unsigned child)
+{
+    const oct_children c = oct_node_children(g, node);
+    return c.first + oct_popcount64(c.mask & ((1u << child) - 1u));
 }
 
 /* --- Reader ------------------------------------------------------------ */

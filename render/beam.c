@@ -206,6 +206,17 @@ static double basis_slack(const camera *cam, double umax, double vmax)
  * relative 2^-40 for the division and a direction's length of 1 +- ulps. */
 static double t_down(double dist, double scale) { return dist / scale * (1.0 - 0x1p-40); }
 
+/* The plane through the eye where q.X / q.F = at (X = R for u, U for v):
+ * normal X - at F, and the sum of its absolute components. */
+static void boundary_plane(const double X[3], const double F[3], double at, double a[3], double *m)
+{
+    *m = 0.0;
+    for (int i = 0; i < 3; i++) {
+        a[i] = X[i] - at * F[i];
+        *m += fabs(a[i]);
+    }
+}
+
 /* Sub-block boundaries: `n` near-equal parts of [a, b). */
 static unsigned grid_split(uint32_t a, uint32_t b, uint32_t *at)
 {
@@ -233,22 +244,12 @@ int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i
     const double *F = cam->forward, *R = cam->right, *U = cam->up;
     bw.cols = grid->cols;
     bw.rows = grid->rows;
-    for (unsigned k = 1; k < bw.cols; k++) {
-        const double ub = 0.5 * (camera_u(cam, grid->col[k] - 1) + camera_u(cam, grid->col[k]));
-        bw.col_m[k] = 0.0;
-        for (int i = 0; i < 3; i++) {
-            bw.col_a[k][i] = R[i] - ub * F[i];
-            bw.col_m[k] += fabs(bw.col_a[k][i]);
-        }
-    }
-    for (unsigned k = 1; k < bw.rows; k++) {
-        const double vb = 0.5 * (camera_v(cam, grid->row[k] - 1) + camera_v(cam, grid->row[k]));
-        bw.row_m[k] = 0.0;
-        for (int i = 0; i < 3; i++) {
-            bw.row_a[k][i] = U[i] - vb * F[i];
-            bw.row_m[k] += fabs(bw.row_a[k][i]);
-        }
-    }
+    for (unsigned k = 1; k < bw.cols; k++)
+        boundary_plane(R, F, 0.5 * (camera_u(cam, grid->col[k] - 1) + camera_u(cam, grid->col[k])),
+                       bw.col_a[k], &bw.col_m[k]);
+    for (unsigned k = 1; k < bw.rows; k++)
+        boundary_plane(U, F, 0.5 * (camera_v(cam, grid->row[k] - 1) + camera_v(cam, grid->row[k])),
+                       bw.row_a[k], &bw.row_m[k]);
     /* Grid units, the eye placed as the traversal places it: cell centres
      * are exact and, relative to the eye, carry one rounding of
      * ulp(max(|o|, N)), as the traversal's plane times do. The margin covers

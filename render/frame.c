@@ -148,13 +148,18 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
     for (unsigned sr = 0; sr < g.rows; sr++)
         for (unsigned sc = 0; sc < g.cols; sc++) {
             const double t_lo = g.t_lo[sr][sc];
-            const int empty = !(t_lo < INFINITY); /* every ray of the sub-block misses */
+            if (!(t_lo < INFINITY)) { /* every ray of the sub-block misses: no direction */
+                for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++)
+                    for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++)
+                        render_pixel(job, i, j, cam->forward, NULL, NULL, hits, steps);
+                continue;
+            }
             /* the sub-block's rays all start at t_lo: where they do, the
              * descent from the root is shared (not with --beam 0: rays
              * traced whole, the reference the beam is tested against) */
             trace_anchor an;
             an.depth = 0;
-            if (!empty && eye->ok && job->beam_size) {
+            if (eye->ok && job->beam_size) {
                 double lo[3], hi[3];
                 beam_start_box(cam, eye->o, eye->scale, g.col[sc], g.col[sc + 1], g.row[sr],
                                g.row[sr + 1], t_lo, lo, hi);
@@ -163,10 +168,6 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
             for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++) {
                 const double v = camera_v(cam, j);
                 for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++) {
-                    if (empty) { /* a miss needs no direction */
-                        render_pixel(job, i, j, cam->forward, NULL, NULL, hits, steps);
-                        continue;
-                    }
                     double dir[3];
                     camera_ray_uv(cam, us[i - us0], v, dir);
                     trace_ray r;

@@ -423,6 +423,22 @@ static void test_tree_util_layout(void **state)
     tree_util_free(t);
 }
 
+/* Up to n distinct voxels drawn from [lo, lo + width)^3 into xyz; returns
+ * how many. */
+static size_t distinct_voxels(size_t n, uint32_t lo, uint32_t width, uint32_t (*xyz)[3])
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t v[3] = {lo + irand(width), lo + irand(width), lo + irand(width)};
+        int dup = 0;
+        for (size_t j = 0; j < m && !dup; j++)
+            dup = !memcmp(xyz[j], v, sizeof v);
+        if (!dup)
+            memcpy(xyz[m++], v, sizeof v);
+    }
+    return m;
+}
+
 /* trace_clip: a ray started at any plane time before its hit (or at the
  * hit's own entry time) meets the same voxel at the same t, bits and all, as
  * the whole ray: rays full of exact ties (dyadic eyes, direction components
@@ -439,17 +455,10 @@ static void test_clip_same_hit(void **state)
         uint32_t *attr = malloc(n * sizeof *attr);
         assert_non_null(xyz);
         assert_non_null(attr);
-        size_t m = 0;
-        for (size_t i = 0; i < n; i++) {
-            uint32_t v[3] = {irand(N), irand(N), irand(N)};
-            int dup = 0;
-            for (size_t j = 0; j < m && !dup; j++)
-                dup = !memcmp(xyz[j], v, sizeof v);
-            if (dup)
-                continue;
-            memcpy(xyz[m], v, sizeof v);
+        const size_t m = distinct_voxels(n, 0, N, xyz);
+        for (size_t i = 0; i < m; i++) {
             const double nr[3] = {(double)irand(5) - 2.0, (double)irand(5) - 2.0, 1.0};
-            attr[m++] = oct_voxel_pack(nr, ((double)irand(200) - 100.0) / 128.0);
+            attr[i] = oct_voxel_pack(nr, ((double)irand(200) - 100.0) / 128.0);
         }
         const double origin[3] = {0, 0, 0};
         oct_tree *t = tree_util_build(L, origin, (double)N, (const uint32_t(*)[3])xyz, m, attr, NULL,
@@ -526,21 +535,11 @@ static void test_anchored_same_hit(void **state)
         uint32_t *attr = malloc(n * sizeof *attr);
         assert_non_null(xyz);
         assert_non_null(attr);
-        size_t m = 0;
         /* clustered off the root's mid-planes, so that occupied cells nest
          * deeply */
-        const uint32_t width = N / 4 + 1, c0 = N / 8 + irand(N / 2 + 1);
-        for (size_t i = 0; i < n; i++) {
-            uint32_t v[3] = {c0 + irand(width), c0 + irand(width), c0 + irand(width)};
-            int dup = 0;
-            for (size_t j = 0; j < m && !dup; j++)
-                dup = !memcmp(xyz[j], v, sizeof v);
-            if (dup)
-                continue;
-            memcpy(xyz[m], v, sizeof v);
-            attr[m] = (uint32_t)m + 1;
-            m++;
-        }
+        const size_t m = distinct_voxels(n, N / 8 + irand(N / 2 + 1), N / 4 + 1, xyz);
+        for (size_t i = 0; i < m; i++)
+            attr[i] = (uint32_t)i + 1;
         const double origin[3] = {0, 0, 0};
         oct_tree *t = tree_util_build(L, origin, (double)N, (const uint32_t(*)[3])xyz, m, attr, NULL,
                                       1, NULL);
