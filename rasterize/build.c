@@ -172,7 +172,6 @@ static void worker_free(worker *wk)
 
 /* --- cell tests ----------------------------------------------------------- */
 
-/* World box of a cell, rounded outward and clipped to bounds. 0 if empty. */
 /* Axis k of the cell with integer coordinate ck at depth: its span rounded
  * outward and clipped to the bounds. 0 when it lies beyond them. */
 static int cell_span(const build_ctx *c, unsigned depth, uint64_t ck, int k, interval *span)
@@ -187,6 +186,7 @@ static int cell_span(const build_ctx *c, unsigned depth, uint64_t ck, int k, int
     return span->lo <= span->hi;
 }
 
+/* World box of a cell, rounded outward and clipped to bounds. 0 if empty. */
 static int cell_box(const build_ctx *c, unsigned depth, const uint64_t cell[3], interval box[3],
                     double centre[3])
 {

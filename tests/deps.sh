@@ -7,6 +7,7 @@ pkg-config --exists libpng 2>/dev/null || need="$need libpng-dev"
 pkg-config --exists zlib 2>/dev/null   || need="$need zlib1g-dev"
 command -v pkg-config >/dev/null       || need="$need pkg-config"
 command -v cc >/dev/null               || need="$need gcc"
+command -v gcc-ar >/dev/null           || need="$need gcc"  # the release build's LTO archives
 if [ "${1:-build}" = test ]; then
     pkg-config --exists cmocka 2>/dev/null || need="$need libcmocka-dev"
     [ -f /usr/include/mpfr.h ]             || need="$need libmpfr-dev"  # interval tests check against MPFR
