@@ -55,9 +55,13 @@ ALLLDFLAGS := $(SANFLAGS) $(LTOFLAGS) $(LDFLAGS)
 B := build/$(VARIANT)
 
 # One library per layer; a program is its main.c plus the layers below it.
-# format/ depends on libc and zlib only; common/ may use format/.
+# format/ depends on libc and zlib only; common/ is plumbing (diagnostics,
+# numbers, atomic output); common/expr/ the expression engine (scene
+# language, tapes, intervals); common/view/ cameras and images.
 FORMAT_SRC    := $(wildcard format/*.c)
 COMMON_SRC    := $(wildcard common/*.c)
+EXPR_SRC      := $(wildcard common/expr/*.c)
+VIEW_SRC      := $(wildcard common/view/*.c)
 RASTERIZE_SRC := $(filter-out rasterize/main.c,$(wildcard rasterize/*.c))
 RENDER_SRC    := $(filter-out render/main.c,$(wildcard render/*.c))
 BENCH_SRC     := $(filter-out bench/%_main.c,$(wildcard bench/*.c))
@@ -69,11 +73,13 @@ obj = $(patsubst %.c,$(B)/%.o,$(1))
 
 LIB_FORMAT    := $(B)/libformat.a
 LIB_COMMON    := $(B)/libcommon.a
+LIB_EXPR      := $(B)/libexpr.a
+LIB_VIEW      := $(B)/libview.a
 LIB_RASTERIZE := $(B)/librasterize.a
 LIB_RENDER    := $(B)/librender.a
 LIB_BENCH     := $(B)/libbench.a
 LIB_TEST      := $(B)/libtestutil.a
-LIBS := $(LIB_RENDER) $(LIB_RASTERIZE) $(LIB_BENCH) $(LIB_COMMON) $(LIB_FORMAT)
+LIBS := $(LIB_RENDER) $(LIB_RASTERIZE) $(LIB_BENCH) $(LIB_EXPR) $(LIB_VIEW) $(LIB_COMMON) $(LIB_FORMAT)
 
 PROGRAMS   := $(patsubst %/main.c,$(B)/bin/%,$(wildcard rasterize/main.c render/main.c))
 BENCH_PROGS := $(patsubst bench/%_main.c,$(B)/bin/%,$(wildcard bench/*_main.c))
@@ -106,6 +112,8 @@ $(B)/%.o: %.c
 
 $(LIB_FORMAT): $(call obj,$(FORMAT_SRC))
 $(LIB_COMMON): $(call obj,$(COMMON_SRC))
+$(LIB_EXPR): $(call obj,$(EXPR_SRC))
+$(LIB_VIEW): $(call obj,$(VIEW_SRC))
 $(LIB_RASTERIZE): $(call obj,$(RASTERIZE_SRC))
 $(LIB_RENDER): $(call obj,$(RENDER_SRC))
 $(LIB_BENCH): $(call obj,$(BENCH_SRC))

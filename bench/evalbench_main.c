@@ -8,8 +8,8 @@
 #include <time.h>
 
 #include "common/diag.h"
-#include "common/scene.h"
-#include "common/tape.h"
+#include "common/expr/scene.h"
+#include "common/expr/tape.h"
 
 #define LEVEL 10
 #define MIN_SECONDS 0.5 /* per measurement */

@@ -7,7 +7,7 @@
 
 #include "common/diag.h"
 #include "common/parse_num.h"
-#include "common/scene.h"
+#include "common/expr/scene.h"
 
 static const char usage_text[] =
     "usage: gradmax SCENE [--grid N]\n"

@@ -4,7 +4,7 @@
 
 #include <stddef.h>
 
-#include "common/tape.h"
+#include "common/expr/tape.h"
 
 /* Writes the expression of t's root into buf (NUL-terminated), shared
  * sub-expressions repeated (POV-Ray functions have no local names): x^n as

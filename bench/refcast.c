@@ -6,7 +6,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 
-#include "common/interval.h"
+#include "common/expr/interval.h"
 
 #define MAX_DEPTH 64 /* bisections of one segment: 2^-64 is below any tolerance */
 

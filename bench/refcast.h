@@ -5,8 +5,8 @@
 
 #include <stdint.h>
 
-#include "common/camera.h"
-#include "common/scene.h"
+#include "common/view/camera.h"
+#include "common/expr/scene.h"
 
 /* What one ray found. t is +inf on a miss. */
 typedef struct refcast_hit {

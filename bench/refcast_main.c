@@ -9,11 +9,11 @@
 #include <unistd.h>
 
 #include "bench/refcast.h"
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "common/diag.h"
-#include "common/image.h"
+#include "common/view/image.h"
 #include "common/parse_num.h"
-#include "common/scene.h"
+#include "common/expr/scene.h"
 
 static const char usage_text[] =
     "usage: refcast SCENE [-o OUT.png] [--depth OUT.pfm] [--normals OUT.pfm]\n"

@@ -7,7 +7,7 @@
 #include "bench/povexpr.h"
 #include "common/diag.h"
 #include "common/parse_num.h"
-#include "common/scene.h"
+#include "common/expr/scene.h"
 
 #define EXPR_CAP (4u << 20)
 

@@ -8,8 +8,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "common/camera.h"
-#include "common/image.h"
+#include "common/view/camera.h"
+#include "common/view/image.h"
 #include "format/oct_normal.h"
 #include "render/frame.h"
 #include "tests/tree_util.h"

@@ -26,8 +26,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/interval.h"
-#include "common/tape.h"
+#include "common/expr/interval.h"
+#include "common/expr/tape.h"
 #include "format/oct_normal.h"
 
 #define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
@@ -839,7 +839,7 @@ static void stats_add(build_stats *a, const build_stats *b)
  * blobs such as exp(-196 (x - a)^4) underflow into them all over space. The
  * workers flush them to zero (FTZ and DAZ). That stays sound: every interval
  * bound is stepped outward after each operation, and a step from 0 reaches
- * +-DBL_MIN, beyond any flushed value (common/interval.h). */
+ * +-DBL_MIN, beyond any flushed value (common/expr/interval.h). */
 static void flush_subnormals(void)
 {
 #if defined(__SSE2__)

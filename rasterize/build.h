@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "common/scene.h"
+#include "common/expr/scene.h"
 #include "format/oct.h"
 
 typedef enum build_method {

@@ -11,7 +11,7 @@
 #include "common/atomic_file.h"
 #include "common/diag.h"
 #include "common/parse_num.h"
-#include "common/scene.h"
+#include "common/expr/scene.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
 

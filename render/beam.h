@@ -23,7 +23,7 @@
 #ifndef BEAM_H
 #define BEAM_H
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "format/oct.h"
 
 #define BEAM_GRID 4 /* sub-blocks a block side, each with its own start */

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/image.h"
+#include "common/view/image.h"
 #include "render/beam.h"
 
 typedef struct frame_shared {

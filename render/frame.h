@@ -7,7 +7,7 @@
 
 #include <stdint.h>
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "format/oct.h"
 #include "render/shade.h"
 #include "render/trace.h"

@@ -9,9 +9,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "common/diag.h"
-#include "common/image.h"
+#include "common/view/image.h"
 #include "common/parse_num.h"
 #include "format/oct.h"
 #include "render/frame.h"

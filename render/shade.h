@@ -3,7 +3,7 @@
 #ifndef SHADE_H
 #define SHADE_H
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "format/oct.h"
 #include "render/trace.h"
 

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "common/parse_num.h"
 
 void views_defaults(views_view *v)

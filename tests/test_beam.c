@@ -12,7 +12,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 #include "render/beam.h"
 #include "render/trace.h"
 

@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/scene.h"
+#include "common/expr/scene.h"
 #include "format/oct.h"
 #include "format/oct_normal.h"
 #include "rasterize/build.h"

@@ -1,4 +1,4 @@
-/* Tests for common/camera: INTERFACE.md's formula by hand, exact centre rays
+/* Tests for common/view/camera: INTERFACE.md's formula by hand, exact centre rays
  * for odd sizes, rejections. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -8,7 +8,7 @@
 
 #include <math.h>
 
-#include "common/camera.h"
+#include "common/view/camera.h"
 
 static void test_formula_by_hand(void **state)
 {

@@ -13,7 +13,7 @@
 
 #include "bench/compare.h"
 #include "bench/pfm.h"
-#include "common/image.h"
+#include "common/view/image.h"
 
 static void test_pfm_round_trip(void **state)
 {

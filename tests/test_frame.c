@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/image.h"
+#include "common/view/image.h"
 #include "format/oct_normal.h"
 #include "render/frame.h"
 #include "tests/tree_util.h"

@@ -1,4 +1,4 @@
-/* Tests for common/image: PFM bytes exactly as INTERFACE.md, PNG read back
+/* Tests for common/view/image: PFM bytes exactly as INTERFACE.md, PNG read back
  * with libpng, failures leave no file. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,7 +14,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "common/image.h"
+#include "common/view/image.h"
 
 static char dir[64];
 

@@ -1,4 +1,4 @@
-/* Tests for common/interval: per-operation soundness against MPFR at witness
+/* Tests for common/expr/interval: per-operation soundness against MPFR at witness
  * points of many random boxes, point-box widths, and the known pitfalls. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "common/interval.h"
+#include "common/expr/interval.h"
 
 #ifdef __FAST_MATH__
 #error "fast-math breaks the interval arithmetic; build without it"

@@ -15,8 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/interval.h"
-#include "common/scene.h"
+#include "common/expr/interval.h"
+#include "common/expr/scene.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
 

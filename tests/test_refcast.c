@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "bench/refcast.h"
-#include "common/camera.h"
-#include "common/scene.h"
+#include "common/view/camera.h"
+#include "common/expr/scene.h"
 
 static scene *parse(const char *text)
 {

@@ -1,4 +1,4 @@
-/* Tests for common/scene: every statement and grammar rule, precedence,
+/* Tests for common/expr/scene: every statement and grammar rule, precedence,
  * and each error with its exact line and column. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/scene.h"
+#include "common/expr/scene.h"
 
 #ifdef __FAST_MATH__
 #error "fast-math breaks the interval arithmetic; build without it"

@@ -1,4 +1,4 @@
-/* Tests for common/tape: point evaluation of every scene against
+/* Tests for common/expr/tape: point evaluation of every scene against
  * hand-written C, gradients against central differences, interval and
  * interval-gradient enclosures on the scenes and on random expression
  * trees, and pruning. Run from the repository root (reads scenes/). */
@@ -13,8 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/scene.h"
-#include "common/tape.h"
+#include "common/expr/scene.h"
+#include "common/expr/tape.h"
 
 #ifdef __FAST_MATH__
 #error "fast-math breaks the interval arithmetic; build without it"

@@ -195,7 +195,7 @@ check_depth "$T/sh.pfm" 33 33 0.01,0.02,2.5 0,0,0 0,1,0 30 "sphere 0 0 0 0.5015"
 
 # ---- Scenes with poles and undefined regions -------------------------------
 # The interval evaluator meets 0*inf, inf-inf and sqrt(<0) on purpose here and
-# handles them by flag (common/interval.h), so rasterize runs without traps;
+# handles them by flag (common/expr/interval.h), so rasterize runs without traps;
 # the renderer must still produce no NaN, with traps on.
 for e in 'sqrt(x)' '1/x' '1/(x-x)' 'log(x+1)' 'sqrt(x)-0.5+0*y' 'x/(y-y)'; do
     printf 'bounds -1 -1 -1 1 1 1\nsurface %s\n' "$e" >"$T/u.scene"

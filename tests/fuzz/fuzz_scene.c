@@ -9,9 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "common/interval.h"
-#include "common/scene.h"
-#include "common/tape.h"
+#include "common/expr/interval.h"
+#include "common/expr/scene.h"
+#include "common/expr/tape.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

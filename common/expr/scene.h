@@ -5,7 +5,7 @@
 
 #include <stddef.h>
 
-#include "common/tape.h"
+#include "common/expr/tape.h"
 
 #define SCENE_MAX_LINE (1u << 20)  /* bytes in one line, comment included */
 #define SCENE_MAX_FILE (64u << 20) /* bytes in one file */

@@ -1,5 +1,5 @@
 /* camera: the pinhole camera of INTERFACE.md. */
-#include "common/camera.h"
+#include "common/view/camera.h"
 
 #include <math.h>
 

@@ -1,6 +1,6 @@
 /* scene: line-oriented reader for .scene files and a recursive-descent
  * parser for EXPR with a depth limit, building tapes. */
-#include "common/scene.h"
+#include "common/expr/scene.h"
 
 #include <errno.h>
 #include <fcntl.h>

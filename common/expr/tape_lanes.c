@@ -3,7 +3,7 @@
  * tape_eval_grad, in the same order (no contraction: -ffp-contract=off), so
  * the results are the same bits; what changes is that the dispatch on the
  * instruction is paid once per pass and the lane loops are vector code. */
-#include "common/tape.h"
+#include "common/expr/tape.h"
 
 #include <math.h>
 #include <string.h>
@@ -23,28 +23,28 @@ static void fill(double *v, unsigned n)
 #define W 2
 #define FN eval2
 #define SCALE scale2
-#include "common/tape_lanes_body.h"
+#include "common/expr/tape_lanes_body.h"
 #undef W
 #undef FN
 #undef SCALE
 #define W 4
 #define FN eval4
 #define SCALE scale4
-#include "common/tape_lanes_body.h"
+#include "common/expr/tape_lanes_body.h"
 #undef W
 #undef FN
 #undef SCALE
 #define W 6
 #define FN eval6
 #define SCALE scale6
-#include "common/tape_lanes_body.h"
+#include "common/expr/tape_lanes_body.h"
 #undef W
 #undef FN
 #undef SCALE
 #define W 8
 #define FN eval8
 #define SCALE scale8
-#include "common/tape_lanes_body.h"
+#include "common/expr/tape_lanes_body.h"
 
 /* The fewest lanes that hold n: the arithmetic runs on every lane. */
 void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[L], const double y[L],

@@ -1,6 +1,6 @@
 /* tape: builder (hash-consing, constant folding, integer powers), the four
  * evaluators and the pruner. */
-#include "common/tape.h"
+#include "common/expr/tape.h"
 
 #include <math.h>
 #include <stdlib.h>

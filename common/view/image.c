@@ -1,5 +1,5 @@
 /* image: atomic PNG and PFM writers. */
-#include "common/image.h"
+#include "common/view/image.h"
 
 #include <errno.h>
 #include <math.h>

@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#include "common/interval.h"
+#include "common/expr/interval.h"
 
 /* Instruction i writes slot i; operands name earlier slots, so a tape is
  * evaluated by one forward loop. */
@@ -116,7 +116,7 @@ double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dua
  * z[l]) for l < n (1 <= n <= TAPE_LANES). The arithmetic runs on every lane
  * (the compiler vectorises it), so one pass over the tape serves n points;
  * lanes from n on repeat lane 0. `slots` is the caller's scratch of t->n
- * elements (common/tape_lanes.c). */
+ * elements (common/expr/tape_lanes.c). */
 #define TAPE_LANES 8
 typedef struct tape_dual_lanes {
     double v[TAPE_LANES], d[3][TAPE_LANES];

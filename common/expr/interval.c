@@ -1,6 +1,6 @@
 /* interval: sound interval arithmetic in double (see interval.h for the
  * rounding and flag rules). */
-#include "common/interval.h"
+#include "common/expr/interval.h"
 
 #include <float.h>
 #include <math.h>
