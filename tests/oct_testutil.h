@@ -40,7 +40,7 @@ oct_err test_tree_write(const test_tree *t, unsigned char **buf, size_t *len);
  * header's own offsets and skips any section outside the buffer. */
 void test_oct_refresh_crcs(unsigned char *buf, size_t len);
 
-/* xorshift64* */
+/* xorshift64* (tests/rng.h); a zero *state starts from a fixed seed. */
 uint64_t test_rand(uint64_t *state);
 
 #endif

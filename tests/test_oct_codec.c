@@ -15,6 +15,7 @@
 #include "format/oct.h"
 #include "format/oct_normal.h"
 #include "tests/oct_testutil.h"
+#include "tests/rng.h"
 
 static void test_normal_codec_error(void **state)
 {
@@ -25,7 +26,7 @@ static void test_normal_codec_error(void **state)
         double v[3], l;
         do { /* uniform on the sphere by rejection */
             for (int k = 0; k < 3; k++)
-                v[k] = (double)(test_rand(&rs) >> 11) * 0x1p-53 * 2.0 - 1.0;
+                v[k] = rng_unit(test_rand(&rs)) * 2.0 - 1.0;
             l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         } while (l > 1.0 || l < 1e-3);
         for (int k = 0; k < 3; k++)
