@@ -41,7 +41,7 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
  * the full test (docs/perf-log.md, rasterize). */
 #define RETEST_MARGIN 0.03125
 int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
-                                      const interval box[3], const double centre[3], double fd)
+                               const interval box[3], const double centre[3], double fd)
 {
     double wlo = 0.0, whi = 0.0; /* G . (box - c) in plain double: the margin covers rounding */
     for (int k = 0; k < 3; k++) {
@@ -119,14 +119,14 @@ static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned dep
 }
 
 int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
-                          const interval box[3], const double centre[3])
+                   const interval box[3], const double centre[3])
 {
     unsigned flags;
     return surface_may_cross(wk, t, s, depth, box, centre, &flags);
 }
 
 unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
-                          interval box[3], double centre[3])
+                   interval box[3], double centre[3])
 {
     const build_ctx *c = wk->c;
     if (!cell_box(c, depth, cell, box, centre))
@@ -170,8 +170,8 @@ unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cel
  * than the plain interval as well as cheaper. Returns 0 when G or f(c) may be
  * undefined (then the caller tests the children one by one). */
 int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
-                            unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
-                            interval out[8])
+                     unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
+                     interval out[8])
 {
     const build_ctx *c = wk->c;
     interval fc, half[3][2];

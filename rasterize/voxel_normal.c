@@ -139,7 +139,7 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
 }
 
 void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
-                        const uint8_t *surf, newton *nw, unsigned np)
+                 const uint8_t *surf, newton *nw, unsigned np)
 {
     const build_ctx *c = wk->c;
     double h = c->cell_edge[c->levels];
