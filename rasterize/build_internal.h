@@ -109,8 +109,8 @@ void worker_free(worker *wk);
  * (lists at index pidx). Fills the cell's lists at index depth + 1 and, when
  * it will be subdivided, its pruned tapes; box and centre receive the cell's
  * box. Returns how many surfaces may cross it. */
-unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
-                   interval box[3], double centre[3]);
+unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
+                             interval box[3], double centre[3]);
 
 /* The plain test of surface s (tape t) on one cell: 0 when the cell
  * provably holds no point of it. */

@@ -125,8 +125,8 @@ int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
     return surface_may_cross(wk, t, s, depth, box, centre, &flags);
 }
 
-unsigned test_cell(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
-                   interval box[3], double centre[3])
+unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
+                             interval box[3], double centre[3])
 {
     const build_ctx *c = wk->c;
     if (!cell_box(c, depth, cell, box, centre))

@@ -1,7 +1,7 @@
 /* subdivide: the recursion. A task's cell is subdivided depth-first,
  * children in slot order, so every depth's nodes come out in Morton order.
  * Above the finest MEAN_VALUE_LEVELS a child is tested on its own with its
- * parent's pruned tapes (test_cell); there and below, all eight at once with
+ * parent's pruned tapes (cell_test_surviving); there and below, all eight at once with
  * the mean-value form (child_enclosures). */
 #include "rasterize/build_internal.h"
 #include "rasterize/cell_geometry.h"
@@ -149,7 +149,7 @@ static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
                               2 * cell[2] + (i >> 2)};
             interval box[3];
             double centre[3];
-            if (!test_cell(wk, depth + 1, depth + 1, cc, box, centre))
+            if (!cell_test_surviving(wk, depth + 1, depth + 1, cc, box, centre))
                 continue;
             if (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc))
                 mask |= (uint8_t)(1u << i);
@@ -183,6 +183,6 @@ void run_task(worker *wk, uint64_t task, task_out *out)
     wk->out = out;
     interval box[3];
     double centre[3];
-    if (test_cell(wk, 0, c->task_depth, cell, box, centre))
+    if (cell_test_surviving(wk, 0, c->task_depth, cell, box, centre))
         out->nonempty = visit_node(wk, c->task_depth, cell) != 0;
 }
