@@ -68,6 +68,109 @@ void scene_free(scene *s)
     free(s);
 }
 
+/* bounds X0 Y0 Z0 X1 Y1 Z1, at most once; start is the keyword's offset. */
+static void read_bounds(expr_parser *p, scene *sc, size_t start, int *have_bounds,
+                        unsigned *bounds_line)
+{
+    if (*have_bounds) {
+        expr_fail_at(p, start, "bounds already given on line %u", *bounds_line);
+        return;
+    }
+    double v[6];
+    size_t cols[6];
+    if (!read_numbers(p, "bounds", 6, v, cols))
+        return;
+    for (int a = 0; a < 3; a++)
+        if (!(v[a + 3] > v[a])) {
+            expr_fail_at(p, cols[a + 3], "empty bounds: %c1 (%g) must be greater than %c0 (%g)",
+                         'X' + a, v[a + 3], 'X' + a, v[a]);
+            return;
+        }
+    for (int a = 0; a < 3; a++) {
+        sc->lo[a] = v[a];
+        sc->hi[a] = v[a + 3];
+    }
+    *have_bounds = 1;
+    *bounds_line = p->line;
+}
+
+/* surface EXPR: compiles EXPR to a tape and appends the surface, grey
+ * until a color follows. *cap is the allocated length of sc->surfaces. */
+static void read_surface(expr_parser *p, scene *sc, size_t start, int *has_color, size_t *cap)
+{
+    if (sc->nsurfaces == *cap) {
+        size_t nc = *cap ? *cap * 2 : 4;
+        scene_surface *ns = realloc(sc->surfaces, nc * sizeof *ns);
+        if (!ns) {
+            expr_fail_at(p, start, "out of memory");
+            return;
+        }
+        sc->surfaces = ns;
+        *cap = nc;
+    }
+    p->b = tape_builder_new();
+    if (!p->b) {
+        expr_fail_at(p, start, "out of memory");
+        return;
+    }
+    if (p->s[p->pos] != ' ' && p->s[p->pos] != '\t' && p->s[p->pos] != '\0') {
+        char what[32];
+        expr_describe(p, p->pos, what, sizeof what);
+        expr_fail_at(p, p->pos, "unexpected %s after 'surface'", what);
+        goto done;
+    }
+    int32_t root = expr_parse(p);
+    if (root < 0)
+        goto done;
+    expr_skip_ws(p);
+    if (p->s[p->pos] != '\0') {
+        char what[32];
+        expr_describe(p, p->pos, what, sizeof what);
+        if (p->s[p->pos] == ')')
+            expr_fail_at(p, p->pos, "unmatched ')'");
+        else
+            expr_fail_at(p, p->pos, "unexpected %s after the expression", what);
+        goto done;
+    }
+    scene_surface *sf = &sc->surfaces[sc->nsurfaces];
+    if (tape_builder_finish(p->b, root, &sf->tape) != TAPE_OK) {
+        expr_fail_at(p, start, "out of memory");
+        goto done;
+    }
+    sf->color[0] = sf->color[1] = sf->color[2] = SCENE_DEFAULT_COLOR;
+    sf->line = p->line;
+    sc->nsurfaces++;
+    *has_color = 0;
+done:
+    tape_builder_free(p->b);
+    p->b = NULL;
+}
+
+/* color R G B, for the surface just above, at most once. */
+static void read_color(expr_parser *p, scene *sc, size_t start, int *has_color)
+{
+    if (sc->nsurfaces == 0) {
+        expr_fail_at(p, start, "color before any surface");
+        return;
+    }
+    if (*has_color) {
+        expr_fail_at(p, start, "the surface on line %u already has a color",
+                     sc->surfaces[sc->nsurfaces - 1].line);
+        return;
+    }
+    double v[3];
+    size_t cols[3];
+    if (!read_numbers(p, "color", 3, v, cols))
+        return;
+    for (int i = 0; i < 3; i++)
+        if (!(v[i] >= 0.0 && v[i] <= 1.0)) {
+            expr_fail_at(p, cols[i], "color component %g outside 0..1", v[i]);
+            return;
+        }
+    memcpy(sc->surfaces[sc->nsurfaces - 1].color, v, sizeof v);
+    *has_color = 1;
+}
+
 /* Parses one statement line (comment already removed) into sc. */
 static void parse_line(expr_parser *p, scene *sc, int *have_bounds, unsigned *bounds_line,
                        int *has_color, size_t *cap)
@@ -82,97 +185,14 @@ static void parse_line(expr_parser *p, scene *sc, int *have_bounds, unsigned *bo
     const char *w = p->s + start;
     p->pos = start + n;
     if (n == 6 && memcmp(w, "bounds", 6) == 0) {
-        if (*have_bounds) {
-            expr_fail_at(p, start, "bounds already given on line %u", *bounds_line);
-            return;
-        }
-        double v[6];
-        size_t cols[6];
-        if (!read_numbers(p, "bounds", 6, v, cols))
-            return;
-        for (int a = 0; a < 3; a++)
-            if (!(v[a + 3] > v[a])) {
-                expr_fail_at(p, cols[a + 3], "empty bounds: %c1 (%g) must be greater than %c0 (%g)",
-                        'X' + a, v[a + 3], 'X' + a, v[a]);
-                return;
-            }
-        for (int a = 0; a < 3; a++) {
-            sc->lo[a] = v[a];
-            sc->hi[a] = v[a + 3];
-        }
-        *have_bounds = 1;
-        *bounds_line = p->line;
+        read_bounds(p, sc, start, have_bounds, bounds_line);
     } else if (n == 7 && memcmp(w, "surface", 7) == 0) {
-        if (sc->nsurfaces == *cap) {
-            size_t nc = *cap ? *cap * 2 : 4;
-            scene_surface *ns = realloc(sc->surfaces, nc * sizeof *ns);
-            if (!ns) {
-                expr_fail_at(p, start, "out of memory");
-                return;
-            }
-            sc->surfaces = ns;
-            *cap = nc;
-        }
-        p->b = tape_builder_new();
-        if (!p->b) {
-            expr_fail_at(p, start, "out of memory");
-            return;
-        }
-        if (p->s[p->pos] != ' ' && p->s[p->pos] != '\t' && p->s[p->pos] != '\0') {
-            char what[32];
-            expr_describe(p, p->pos, what, sizeof what);
-            expr_fail_at(p, p->pos, "unexpected %s after 'surface'", what);
-            goto done;
-        }
-        int32_t root = expr_parse(p);
-        if (root < 0)
-            goto done;
-        expr_skip_ws(p);
-        if (p->s[p->pos] != '\0') {
-            char what[32];
-            expr_describe(p, p->pos, what, sizeof what);
-            if (p->s[p->pos] == ')')
-                expr_fail_at(p, p->pos, "unmatched ')'");
-            else
-                expr_fail_at(p, p->pos, "unexpected %s after the expression", what);
-            goto done;
-        }
-        scene_surface *sf = &sc->surfaces[sc->nsurfaces];
-        if (tape_builder_finish(p->b, root, &sf->tape) != TAPE_OK) {
-            expr_fail_at(p, start, "out of memory");
-            goto done;
-        }
-        sf->color[0] = sf->color[1] = sf->color[2] = SCENE_DEFAULT_COLOR;
-        sf->line = p->line;
-        sc->nsurfaces++;
-        *has_color = 0;
-    done:
-        tape_builder_free(p->b);
-        p->b = NULL;
+        read_surface(p, sc, start, has_color, cap);
     } else if (n == 5 && memcmp(w, "color", 5) == 0) {
-        if (sc->nsurfaces == 0) {
-            expr_fail_at(p, start, "color before any surface");
-            return;
-        }
-        if (*has_color) {
-            expr_fail_at(p, start, "the surface on line %u already has a color",
-                    sc->surfaces[sc->nsurfaces - 1].line);
-            return;
-        }
-        double v[3];
-        size_t cols[3];
-        if (!read_numbers(p, "color", 3, v, cols))
-            return;
-        for (int i = 0; i < 3; i++)
-            if (!(v[i] >= 0.0 && v[i] <= 1.0)) {
-                expr_fail_at(p, cols[i], "color component %g outside 0..1", v[i]);
-                return;
-            }
-        memcpy(sc->surfaces[sc->nsurfaces - 1].color, v, sizeof v);
-        *has_color = 1;
+        read_color(p, sc, start, has_color);
     } else if (n > 0) {
         expr_fail_at(p, start, "unknown statement '%.*s' (expected bounds, surface or color)",
-                (int)(n > 64 ? 64 : n), w);
+                     (int)(n > 64 ? 64 : n), w);
     } else {
         char what[32];
         expr_describe(p, start, what, sizeof what);
