@@ -30,12 +30,6 @@ int diag_usage_error(const char *usage, const char *fmt, ...) __attribute__((for
 /* True when stderr is a terminal (progress bars are drawn only then). */
 int diag_stderr_is_tty(void);
 
-/* DDA_FPE_TRAPS=1 in the environment (tests only): trap invalid operations
- * (NaN from 0*inf, inf-inf, sqrt(-1) ...) with SIGFPE, so a stray NaN stops
- * the run instead of reaching an output. Call first in main(); threads
- * inherit it. */
-void diag_fpe_traps_from_env(void);
-
 /* Exit codes (INTERFACE.md). */
 enum { EXIT_OK = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 

@@ -11,6 +11,8 @@
 #include "common/atomic_file.h"
 #include "common/diag.h"
 #include "common/parse_num.h"
+#include "common/test_hooks.h"
+#include "common/version.h"
 #include "common/expr/scene.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
@@ -36,6 +38,7 @@ static const char help_text[] =
     "  --threads N            worker threads (default: the number of cores)\n"
     "  -q, --quiet            no progress bar and no summary\n"
     "  -h, --help             this text\n"
+    "  --version              print the version and exit\n"
     "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 
@@ -92,7 +95,7 @@ static void print_summary(const char *out, unsigned levels, const build_stats *s
 int main(int argc, char **argv)
 {
     diag_set_progname("rasterize");
-    diag_fpe_traps_from_env();
+    test_hooks_init();
     const char *scene_path = NULL, *out_path = NULL;
     long levels = DEFAULT_LEVELS, threads = sysconf(_SC_NPROCESSORS_ONLN);
     build_method method = BUILD_INTERVAL;
@@ -108,6 +111,9 @@ int main(int argc, char **argv)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             fputs(usage_text, stdout);
             fputs(help_text, stdout);
+            return EXIT_OK;
+        } else if (!strcmp(a, "--version")) {
+            version_print("rasterize");
             return EXIT_OK;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;

@@ -13,6 +13,8 @@
 #include "common/diag.h"
 #include "common/view/image.h"
 #include "common/parse_num.h"
+#include "common/test_hooks.h"
+#include "common/version.h"
 #include "format/oct.h"
 #include "render/frame.h"
 #include "render/shade.h"
@@ -56,6 +58,7 @@ static const char help_text[] =
     "                      structure is still validated in full\n"
     "  --info              print a summary of FILE.oct\n"
     "  -q                  no per-view timing lines\n"
+    "  --version           print the version and exit\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
 static double now_ms(void)
@@ -150,7 +153,7 @@ static void frame_cube(const oct_tree *t, views_view *v)
 int main(int argc, char **argv)
 {
     diag_set_progname("render");
-    diag_fpe_traps_from_env();
+    test_hooks_init();
     views_view base;
     views_defaults(&base);
     const char *oct_path = NULL, *views_path = NULL;
@@ -174,6 +177,10 @@ int main(int argc, char **argv)
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(usage_text, stdout);
             fputs(help_text, stdout);
+            return EXIT_OK;
+        }
+        if (strcmp(a, "--version") == 0) {
+            version_print("render");
             return EXIT_OK;
         }
         if (a[0] != '-' || a[1] == '\0') {
