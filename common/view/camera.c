@@ -1,4 +1,4 @@
-/* camera: the pinhole camera of INTERFACE.md. */
+/* camera: the pinhole camera of docs/INTERFACE.md. */
 #include "common/view/camera.h"
 
 #include "common/limits.h"
