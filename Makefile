@@ -140,7 +140,9 @@ $(B)/hooks/%.o: %.c
 # --version: VERSION plus the checkout's commit (none outside a checkout).
 # The stamp changes only when that string does, so version.o rebuilds then.
 DDA_VERSION := $(shell cat VERSION)
-DDA_COMMIT  := $(shell git describe --always --dirty 2>/dev/null)
+# (Only this tree's own .git: an unpacked tarball inside another checkout
+# must not take that checkout's commit.)
+DDA_COMMIT  := $(if $(wildcard .git),$(shell git describe --always --dirty 2>/dev/null))
 VERSION_DEFS := -DDDA_VERSION='"$(DDA_VERSION)"' -DDDA_COMMIT='"$(DDA_COMMIT)"'
 $(B)/version.stamp: FORCE
 	@mkdir -p $(dir $@)
