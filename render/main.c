@@ -11,8 +11,11 @@
 
 #include "common/view/camera.h"
 #include "common/diag.h"
+#include "common/limits.h"
 #include "common/view/image.h"
 #include "common/parse_num.h"
+#include "common/test_hooks.h"
+#include "common/version.h"
 #include "format/oct.h"
 #include "render/frame.h"
 #include "render/shade.h"
@@ -34,7 +37,7 @@ static const char help_text[] =
     "\n"
     "Ray traces the voxels of FILE.oct (two-step discrete ray tracing).\n"
     "  -o OUT.png          colour image (8-bit sRGB PNG)\n"
-    "  --size WxH          image size in pixels (default 512x512, each 1..32768)\n"
+    "  --size WxH          image size in pixels (default 512x512, each 1.." LIMIT_STR(CAMERA_MAX_SIZE) ")\n"
     "  --eye, --target     camera position and aim (default: a view framing the cube)\n"
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
     "  --fov DEG           vertical field of view, in (0, 180) (default 30)\n"
@@ -48,7 +51,8 @@ static const char help_text[] =
     "                      (default 32; 0: off; same image)\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
     "  --background R,G,B  linear colour of rays that miss, 0..1 each (default 0,0,0)\n"
-    "  --threads N         worker threads (default: online CPUs)\n"
+    "  --threads N         worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: online CPUs, at most "
+    LIMIT_STR(THREADS_DEFAULT_MAX) ")\n"
     "  --views FILE        one view a line, same options as above ('#' comments)\n"
     "  --orbit N           N views on a circle around the target; -o is a pattern\n"
     "                      with one integer conversion, e.g. frame_%04d.png\n"
@@ -56,6 +60,7 @@ static const char help_text[] =
     "                      structure is still validated in full\n"
     "  --info              print a summary of FILE.oct\n"
     "  -q                  no per-view timing lines\n"
+    "  --version           print the version and exit\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
 static double now_ms(void)
@@ -150,7 +155,7 @@ static void frame_cube(const oct_tree *t, views_view *v)
 int main(int argc, char **argv)
 {
     diag_set_progname("render");
-    diag_fpe_traps_from_env();
+    test_hooks_init();
     views_view base;
     views_defaults(&base);
     const char *oct_path = NULL, *views_path = NULL;
@@ -174,6 +179,10 @@ int main(int argc, char **argv)
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             fputs(usage_text, stdout);
             fputs(help_text, stdout);
+            return EXIT_OK;
+        }
+        if (strcmp(a, "--version") == 0) {
+            version_print("render");
             return EXIT_OK;
         }
         if (a[0] != '-' || a[1] == '\0') {
@@ -218,7 +227,7 @@ int main(int argc, char **argv)
         } else if (strcmp(a, "--split") == 0) {
             e = parse_long(val, 0, OCT_MAX_LEVELS, &split);
         } else if (strcmp(a, "--threads") == 0) {
-            e = parse_long(val, 1, 256, &threads);
+            e = parse_long(val, 1, THREADS_MAX, &threads);
         } else if (strcmp(a, "--beam") == 0) {
             e = parse_long(val, 0, FRAME_TILE, &beam);
         } else if (strcmp(a, "--light") == 0) {
@@ -376,7 +385,7 @@ int main(int argc, char **argv)
     }
     if (threads == 0) {
         long n = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = n < 1 ? 1 : n > 64 ? 64 : n;
+        threads = n < 1 ? 1 : n > THREADS_DEFAULT_MAX ? THREADS_DEFAULT_MAX : n;
     }
 
     double total_ms = 0.0;

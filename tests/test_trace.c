@@ -14,7 +14,7 @@
 
 #include "format/oct_normal.h"
 #include "render/trace.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
 
 /* xorshift64*: deterministic, seedable */
 static uint64_t rng_state = 0x9e3779b97f4a7c15u;

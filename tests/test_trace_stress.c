@@ -37,7 +37,7 @@
 #include <string.h>
 
 #include "render/trace.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SANITIZED 1

@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "render/trace.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
