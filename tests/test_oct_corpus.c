@@ -11,7 +11,7 @@
 
 #include "format/oct.h"
 #include "format/oct_layout.h"
-#include "tests/oct_testutil.h"
+#include "bench/oct_synth.h"
 
 static void test_make_fuzz_corpus(void **state)
 {
