@@ -50,10 +50,14 @@ long trace_oracle_first(const trace_ray *r, unsigned levels, const uint32_t (*vo
     return best;
 }
 
-static int same_hit(const trace_hit *a, const trace_hit *b)
+/* xyz is the voxel the traversal stopped in; an empty tree stops before
+ * any, leaving it unset. */
+static int same_hit(const oct_tree *tree, const trace_hit *a, const trace_hit *b)
 {
-    if (a->hit != b->hit || a->steps != b->steps || a->xyz[0] != b->xyz[0] ||
-        a->xyz[1] != b->xyz[1] || a->xyz[2] != b->xyz[2])
+    if (a->hit != b->hit || a->steps != b->steps)
+        return 0;
+    if (tree->node_count[0] != 0 &&
+        (a->xyz[0] != b->xyz[0] || a->xyz[1] != b->xyz[1] || a->xyz[2] != b->xyz[2]))
         return 0;
     if (!a->hit)
         return 1;
@@ -67,7 +71,7 @@ static int run_all(const oct_tree *tree, const trace_opts *opts, const trace_ray
     for (unsigned i = 1; i < trace_impl_count; i++) {
         trace_hit h;
         trace_impls[i].traverse(tree, opts, r, a, &h);
-        if (!same_hit(hit, &h)) {
+        if (!same_hit(tree, hit, &h)) {
             fprintf(stderr,
                     "trace implementations differ (K=%u refine=%d, anchor depth %u): %s hit %d "
                     "(%u %u %u) t %a steps %u; %s hit %d (%u %u %u) t %a steps %u\n",
