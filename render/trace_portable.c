@@ -46,7 +46,7 @@ static double min3(const double t[3])
  * ray is in at tc; per axis the far half when the mid plane is crossed at or
  * before tc, and the child's exit time is the mid plane's (near) or the
  * cell's own (far: tp). Sets ci to the child's index when ci is not NULL. */
-static void enter_child(const walk *w, uint32_t v[3], uint32_t *size, double tc, double t[3],
+static void enter(const walk *w, uint32_t v[3], uint32_t *size, double tc, double t[3],
                         const double tp[3], unsigned *ci)
 {
     const uint32_t half = *size >> 1;
@@ -75,7 +75,7 @@ static uint32_t voxel_walk(const walk *w, double tc, uint32_t steps, uint32_t ma
     double t[3] = {w->t[0], w->t[1], w->t[2]};
     const double te_cell = min3(t);
     while (size > 1)
-        enter_child(w, v, &size, tc, t, t, NULL);
+        enter(w, v, &size, tc, t, t, NULL);
     for (;;) {
         const double te = min3(t);
         if (te >= te_cell || ++steps > max_steps)
@@ -168,7 +168,7 @@ int trace_traverse_portable(const oct_tree *tree, const trace_opts *opts, const 
     uint32_t steps = 0;
     int side = 0; /* --refine: see trace_refine_voxel */
 
-    enter_child(&w, w.v, &w.size, tc, w.t, w.tp, &w.ci);
+    enter(&w, w.v, &w.size, tc, w.t, w.tp, &w.ci);
     w.d++;
     for (;;) {
         if (w.mask >> w.ci & 1u) {
@@ -197,7 +197,7 @@ int trace_traverse_portable(const oct_tree *tree, const trace_opts *opts, const 
                 w.mask = ch.mask;
                 w.prefix = ch.first;
                 memcpy(w.tp, w.t, sizeof w.tp);
-                enter_child(&w, w.v, &w.size, tc, w.t, w.tp, &w.ci);
+                enter(&w, w.v, &w.size, tc, w.t, w.tp, &w.ci);
                 w.d++;
                 continue;
             }

@@ -1,6 +1,7 @@
 /* Tests for render/trace: the two-step traversal against a brute-force oracle
  * that slab-tests every voxel, for every split K, on random sparse trees and
- * deep single-path trees; degenerate rays; the step bound. */
+ * deep single-path trees; degenerate rays; the step bound. Every cast runs
+ * each traversal implementation built (tests/trace_oracle.h). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,7 +23,7 @@ static uint64_t rng(void) { return oracle_rng(&rng_state); }
 static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
 
-/* --refine oracle, written from the rule of refine_voxel (trace.c) without
+/* --refine oracle, written from the rule of trace_refine_voxel without
  * the traversal: the voxels the ray occupies for a non-empty time [lo, hi)
  * in the order of lo; a run is a sequence of them each starting where the
  * previous one ends (no empty cell between). The ray hits the first voxel
