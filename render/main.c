@@ -433,8 +433,9 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
         diag_path_error(v->depth, "%s: %s", op ? op : "write", strerror(errno));
         return EXIT_RUNTIME;
     }
-    if (v->normals && (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, buf->nrm_f, w, h, &op)
-                                          : image_write_png(v->normals, buf->nrm, w, h, &op)) != 0) {
+    if (v->normals &&
+        (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, buf->nrm_f, w, h, &op)
+                            : image_write_png(v->normals, buf->nrm, w, h, &op)) != 0) {
         diag_path_error(v->normals, "%s: %s", op ? op : "write", strerror(errno));
         return EXIT_RUNTIME;
     }

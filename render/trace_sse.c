@@ -296,8 +296,8 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
         unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
         if (~(ci ^ far) & smask) {
             /* a stepped axis on the far half leaves the parent too */
-            if (!climb(fr, &ax, TEv, &d, &ci, &size, &V, &smask, &Exy, &Ezw, &Txy, &Tzw, &TPxy, &TPzw,
-                       &M, &P))
+            if (!climb(fr, &ax, TEv, &d, &ci, &size, &V, &smask, &Exy, &Ezw, &Txy, &Tzw, &TPxy,
+                       &TPzw, &M, &P))
                 goto out;
         }
         ci ^= smask;
