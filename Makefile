@@ -55,6 +55,10 @@ ALLCFLAGS := $(BASEFLAGS) $(CFLAGS) $(SANFLAGS) $(LTOFLAGS)
 ALLLDFLAGS := $(SANFLAGS) $(LTOFLAGS) $(LDFLAGS)
 
 B := build/$(VARIANT)
+# a build for another target (make ARCHFLAGS=...) keeps its own objects
+ifeq ($(origin ARCHFLAGS),command line)
+  B := build/$(VARIANT)$(subst =,-,$(word 1,$(ARCHFLAGS)))
+endif
 
 # One library per layer; a program is its main.c plus the layers it may use,
 # and its link line names only those, so a call the wrong way fails to link.
