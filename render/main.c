@@ -54,7 +54,8 @@ static const char help_text[] =
     "                      with one integer conversion, e.g. frame_%04d.png\n"
     "  --trust             skip the file's CRC-32 checks (a fixed cost per file); the\n"
     "                      structure is still validated in full\n"
-    "  --info              print a summary of FILE.oct\n"
+    "  --info              print a summary of FILE.oct (format version, flags,\n"
+    "                      tree, stored function, shard fields)\n"
     "  -q                  no per-view timing lines\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
@@ -277,14 +278,14 @@ int main(int argc, char **argv)
     }
 
     {
-        uint64_t off = 0;
-        oct_err err = oct_open(oct_path, trust ? OCT_OPEN_TRUST : 0u, &file, &off);
+        oct_fault fault;
+        oct_err err = oct_open_fault(oct_path, trust ? OCT_OPEN_TRUST : 0u, &file, &fault);
         if (err != OCT_OK) {
             if (err == OCT_EIO)
                 diag_path_error(oct_path, "%s", strerror(errno));
-            else if (off)
-                diag_path_error(oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
-                                (unsigned long long)off);
+            else if (fault.offset)
+                diag_path_error(oct_path, "corrupt: %s at offset %llu", fault.what,
+                                (unsigned long long)fault.offset);
             else
                 diag_path_error(oct_path, "%s", oct_strerror(err));
             status = EXIT_RUNTIME;
@@ -299,6 +300,11 @@ int main(int argc, char **argv)
     }
     if (!views_path && !base.out)
         goto done; /* --info only */
+    if (oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) { /* only the function can place hits */
+        diag_path_error(oct_path, "stores no normals (rasterized with --shell-only): use --exact");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
     if (split > (long)tree->levels) {
         snprintf(msg, sizeof msg, "--split %ld: the tree has only %u levels", split,
                  (unsigned)tree->levels);
