@@ -8,7 +8,7 @@
 
 #include "common/expr/tape.h"
 #include "format/oct.h"
-#include "tests/oct_testutil.h"
+#include "bench/oct_synth.h"
 
 /* A tape holding every tape_op at least once (an inexact constant, an exact
  * fractional power), all of them live. Free with tape_free. Aborts on

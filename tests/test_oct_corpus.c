@@ -11,8 +11,8 @@
 
 #include "format/oct.h"
 #include "format/oct_layout.h"
+#include "bench/oct_synth.h"
 #include "tests/oct_fn_util.h"
-#include "tests/oct_testutil.h"
 
 static void write_file(const char *dir, const char *name, const unsigned char *buf, size_t len)
 {

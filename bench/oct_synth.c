@@ -1,9 +1,9 @@
-/* oct_testutil: random sparse voxel trees and writer round trips for tests. */
-#include "tests/oct_testutil.h"
+/* oct_synth: random sparse voxel trees and writer round trips for tests and benchmarks. */
+#include "bench/oct_synth.h"
 
 #include "format/oct_layout.h"
 #include "format/oct_normal.h"
-#include "tests/rng.h"
+#include "bench/rng.h"
 
 #include <math.h>
 #include <stdio.h>
