@@ -63,11 +63,11 @@ queue_empty() { [ -z "$(squeue -h -o %i 2>/dev/null)" ]; }
 stopped() { ! running "$1"; }
 
 start() {
+    mkdir -p "$D" && [ -z "$(ls -A "$D")" ] || die "$D: not a new or empty directory"
     for c in munged slurmctld slurmd sinfo; do
         command -v "$c" >/dev/null 2>&1 || die "$c not found: install slurm-wlm and munge"
     done
     [ "$(id -u)" -eq 0 ] || die "needs root: the daemons run as root (SlurmUser=root)"
-    mkdir -p "$D" && [ -z "$(ls -A "$D")" ] || die "$D: not a new or empty directory"
     D=$(cd "$D" && pwd)
     # munged wants every directory above its socket searchable by all
     chmod 755 "$D"

@@ -70,6 +70,18 @@ RENDER=no-such-render expect_exit 1 sh "$F/parallel-render.sh" "$T/s.oct" --view
 expect_err "RENDER=no-such-render: not found in PATH"
 [ ! -e "$T/o.oct" ] || fail "a failed run wrote o.oct"
 
+# local-slurm.sh: its commands, and no cluster where there is none.
+expect_exit 0 sh "$F/local-slurm.sh" --help
+grep -q '^usage: farm/local-slurm.sh start DIR' "$OUT" || fail "local-slurm.sh --help"
+expect_exit 2 sh "$F/local-slurm.sh"
+expect_exit 2 sh "$F/local-slurm.sh" begin "$T/c"
+expect_err "unknown command 'begin'"
+expect_exit 2 sh "$F/local-slurm.sh" start
+expect_exit 1 sh "$F/local-slurm.sh" stop "$T"
+expect_err "$T: no cluster here"
+expect_exit 1 sh "$F/local-slurm.sh" start "$T"
+expect_err "$T: not a new or empty directory"
+
 # Options rasterize rejects fail in every shard: the first failure's status,
 # OUT.oct as it was, no parts left.
 command -v parallel >/dev/null || fail "GNU parallel is not installed (sh tests/deps.sh test)"
