@@ -10,6 +10,7 @@
 #include "common/diag.h"
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
+#include "bench/rng.h"
 
 #define LEVEL 10
 #define MIN_SECONDS 0.5 /* per measurement */
@@ -17,13 +18,7 @@
 #define BATCH 4096
 
 static uint64_t rng = 0x853c49e6748fea9bull;
-static double unit(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * 0x1p-53;
-}
+static double unit(void) { return rng_unit(rng_xorshift64(&rng)); }
 
 static double now(void)
 {

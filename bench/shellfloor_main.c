@@ -15,6 +15,7 @@
 
 #include "common/diag.h"
 #include "common/parse_num.h"
+#include "bench/rng.h"
 
 static const char usage_text[] =
     "usage: shellfloor DX,DY,DZ [--samples N]\n"
@@ -25,13 +26,7 @@ static const char usage_text[] =
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
 static uint64_t rng_state = 0x2545f4914f6cdd1dULL;
-static double urand(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) * 0x1p-53;
-}
+static double urand(void) { return rng_unit(rng_xorshift64(&rng_state)); }
 
 static double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 

@@ -110,15 +110,18 @@ static oct_err check_tree(const unsigned char *p, uint64_t nodes_off, uint64_t l
     return OCT_OK;
 }
 
-static oct_err validate(oct_file *f, unsigned flags, uint64_t *where)
-{
-    const unsigned char *p = f->data;
-    const uint64_t size = f->size;
-    oct_tree *t = &f->tree;
-    oct_info *in = &f->info;
-    *where = 0;
+/* Where validate found things: the header size and version class, and each
+ * section's offset and length, as checked. */
+typedef struct layout {
+    uint32_t hsize;
+    int known_minor; /* minor <= ours: reserved bytes and trailing bytes are ours to check */
+    uint64_t off[OCT_SEC_COUNT], len[OCT_SEC_COUNT];
+} layout;
 
-    /* Header: identity, then each field's range. */
+/* Magic, version, header size and the byte-order marks. */
+static oct_err check_identity(const unsigned char *p, uint64_t size, oct_info *in, layout *lo,
+                              uint64_t *where)
+{
     size_t mlen = size < OCT_MAGIC_SIZE ? (size_t)size : OCT_MAGIC_SIZE;
     CHECK(size > 0, OCT_ETRUNC, 0);
     CHECK(memcmp(p, OCT_MAGIC, mlen) == 0, OCT_EMAGIC, 0);
@@ -126,14 +129,22 @@ static oct_err validate(oct_file *f, unsigned flags, uint64_t *where)
     in->version_major = rd_u16le(p + OCT_OFF_MAJOR);
     in->version_minor = rd_u16le(p + OCT_OFF_MINOR);
     CHECK(in->version_major == OCT_VERSION_MAJOR, OCT_EVERSION, (uint64_t)OCT_OFF_MAJOR);
-    const int known_minor = in->version_minor <= OCT_VERSION_MINOR;
-    const uint32_t hsize = rd_u32le(p + OCT_OFF_HEADER_SIZE);
-    CHECK(hsize % OCT_ALIGN == 0 && (known_minor ? hsize == OCT_HEADER_SIZE : hsize >= OCT_HEADER_SIZE),
+    lo->known_minor = in->version_minor <= OCT_VERSION_MINOR;
+    lo->hsize = rd_u32le(p + OCT_OFF_HEADER_SIZE);
+    const uint32_t hsize = lo->hsize;
+    CHECK(hsize % OCT_ALIGN == 0 && (lo->known_minor ? hsize == OCT_HEADER_SIZE : hsize >= OCT_HEADER_SIZE),
           OCT_EHEADER, (uint64_t)OCT_OFF_HEADER_SIZE);
     CHECK(hsize <= size, OCT_ETRUNC, (uint64_t)OCT_OFF_HEADER_SIZE);
     CHECK(rd_u32le(p + OCT_OFF_BOM_U32) == OCT_BOM_U32, OCT_EHEADER, (uint64_t)OCT_OFF_BOM_U32);
     CHECK(rd_f64le(p + OCT_OFF_BOM_F64) == OCT_BOM_F64, OCT_EHEADER, (uint64_t)OCT_OFF_BOM_F64);
     CHECK(rd_u32le(p + OCT_OFF_FLAGS) == 0, OCT_EHEADER, (uint64_t)OCT_OFF_FLAGS);
+    return OCT_OK;
+}
+
+/* The tree's header fields, each in its range: levels, the subtree's place
+ * in its grid, the cube, the surface and voxel counts. */
+static oct_err check_header_fields(const unsigned char *p, oct_tree *t, oct_info *in, uint64_t *where)
+{
     t->levels = rd_u32le(p + OCT_OFF_LEVELS);
     CHECK(t->levels >= 1 && t->levels <= OCT_MAX_LEVELS, OCT_EHEADER, (uint64_t)OCT_OFF_LEVELS);
     in->root_depth = rd_u32le(p + OCT_OFF_ROOT_DEPTH);
@@ -157,99 +168,165 @@ static oct_err validate(oct_file *f, unsigned flags, uint64_t *where)
     CHECK(t->surface_count >= 1 && t->surface_count <= OCT_MAX_SURFACES, OCT_EHEADER,
           (uint64_t)OCT_OFF_SURFACE_COUNT);
     t->voxel_count = rd_u64le(p + OCT_OFF_VOXEL_COUNT);
-    if (known_minor) { /* a newer minor may give meaning to these bytes */
-        uint64_t at;
-        CHECK(rd_u32le(p + OCT_OFF_RESERVED0) == 0, OCT_ERESERVED, (uint64_t)OCT_OFF_RESERVED0);
-        for (int k = 0; k < OCT_SEC_COUNT; k++)
-            CHECK(rd_u32le(p + OCT_SEC_OFF(k) + 20) == 0, OCT_ERESERVED, (uint64_t)OCT_SEC_OFF(k) + 20);
-        CHECK(all_zero(p + OCT_OFF_RESERVED1, OCT_OFF_HEADER_CRC - OCT_OFF_RESERVED1, &at),
-              OCT_ERESERVED, OCT_OFF_RESERVED1 + at);
-    }
+    return OCT_OK;
+}
 
-    /* Sections: each of the expected size, in table order, each at the first
-     * 64-byte boundary after the previous one, inside the file. */
-    uint64_t off[OCT_SEC_COUNT], len[OCT_SEC_COUNT], end = hsize;
+/* The header's reserved fields are zero, for the minors this reader knows
+ * (a newer minor may give meaning to these bytes). */
+static oct_err check_header_reserved(const unsigned char *p, const layout *lo, uint64_t *where)
+{
+    if (!lo->known_minor)
+        return OCT_OK;
+    uint64_t at;
+    CHECK(rd_u32le(p + OCT_OFF_RESERVED0) == 0, OCT_ERESERVED, (uint64_t)OCT_OFF_RESERVED0);
+    for (int k = 0; k < OCT_SEC_COUNT; k++)
+        CHECK(rd_u32le(p + OCT_SEC_OFF(k) + 20) == 0, OCT_ERESERVED, (uint64_t)OCT_SEC_OFF(k) + 20);
+    CHECK(all_zero(p + OCT_OFF_RESERVED1, OCT_OFF_HEADER_CRC - OCT_OFF_RESERVED1, &at),
+          OCT_ERESERVED, OCT_OFF_RESERVED1 + at);
+    return OCT_OK;
+}
+
+/* The byte length section k must have, given the header and level counts. */
+static uint64_t section_size(int k, const oct_tree *t)
+{
+    uint64_t want;
+    switch (k) {
+    case OCT_SEC_LEVELS: want = 8u * t->levels; break;
+    case OCT_SEC_NODES:
+        want = 0;
+        for (uint32_t d = 0; d < t->levels; d++)
+            want += 16 * groups_of(t->node_count[d]); /* counts <= 8^d: no overflow */
+        break;
+    case OCT_SEC_VOXELS: want = 4 * t->voxel_count; break; /* voxel_count <= 8^20 */
+    case OCT_SEC_SURFACES: want = t->surface_count > 1 ? t->voxel_count : 0; break;
+    default: want = 12u * t->surface_count; break;
+    }
+    return want;
+}
+
+/* The level counts (section at `off`): each at most 8 times the one above,
+ * since the counts bound every later size. */
+static oct_err check_level_counts(const unsigned char *p, uint64_t off, oct_tree *t, uint64_t *where)
+{
+    for (uint32_t d = 0; d < t->levels; d++) {
+        t->node_count[d] = rd_u64le(p + off + 8 * d);
+        uint64_t cap = d == 0 ? 1 : 8 * t->node_count[d - 1];
+        CHECK(t->node_count[d] <= cap, OCT_ETREE, off + 8 * d);
+    }
+    CHECK(t->voxel_count <= 8 * t->node_count[t->levels - 1], OCT_ETREE, (uint64_t)OCT_OFF_VOXEL_COUNT);
+    return OCT_OK;
+}
+
+/* Sections: each of the expected size, in table order, each at the first
+ * 64-byte boundary after the previous one, inside the file; then no
+ * trailing bytes (for a known minor). */
+static oct_err check_sections(const unsigned char *p, uint64_t size, oct_tree *t, layout *lo,
+                              uint64_t *where)
+{
+    uint64_t end = lo->hsize;
     for (int k = 0; k < OCT_SEC_COUNT; k++) {
         const uint64_t e = OCT_SEC_OFF(k);
-        off[k] = rd_u64le(p + e);
-        len[k] = rd_u64le(p + e + 8);
-        uint64_t want;
-        switch (k) {
-        case OCT_SEC_LEVELS: want = 8u * t->levels; break;
-        case OCT_SEC_NODES:
-            want = 0;
-            for (uint32_t d = 0; d < t->levels; d++)
-                want += 16 * groups_of(t->node_count[d]); /* counts <= 8^d: no overflow */
-            break;
-        case OCT_SEC_VOXELS: want = 4 * t->voxel_count; break; /* voxel_count <= 8^20 */
-        case OCT_SEC_SURFACES: want = t->surface_count > 1 ? t->voxel_count : 0; break;
-        default: want = 12u * t->surface_count; break;
-        }
-        CHECK(len[k] == want, OCT_ESECTION, e + 8);
-        if (len[k] == 0) {
-            CHECK(off[k] == 0 && rd_u32le(p + e + 16) == 0, OCT_ESECTION, e);
+        const uint64_t off = lo->off[k] = rd_u64le(p + e);
+        const uint64_t len = lo->len[k] = rd_u64le(p + e + 8);
+        CHECK(len == section_size(k, t), OCT_ESECTION, e + 8);
+        if (len == 0) {
+            CHECK(off == 0 && rd_u32le(p + e + 16) == 0, OCT_ESECTION, e);
         } else {
-            CHECK(off[k] % OCT_ALIGN == 0 && off[k] >= end, OCT_ESECTION, e); /* aligned, no overlap */
-            CHECK(off[k] == oct_align_up(end), OCT_ESECTION, e);             /* no gap */
-            CHECK(off[k] <= size && len[k] <= size - off[k], OCT_ETRUNC, e);
+            CHECK(off % OCT_ALIGN == 0 && off >= end, OCT_ESECTION, e); /* aligned, no overlap */
+            CHECK(off == oct_align_up(end), OCT_ESECTION, e);           /* no gap */
+            CHECK(off <= size && len <= size - off, OCT_ETRUNC, e);
             uint64_t at;
-            CHECK(all_zero(p + end, off[k] - end, &at), OCT_ERESERVED, end + at);
-            end = off[k] + len[k];
+            CHECK(all_zero(p + end, off - end, &at), OCT_ERESERVED, end + at);
+            end = off + len;
         }
-        if (k == OCT_SEC_LEVELS) { /* the counts bound every later size */
-            for (uint32_t d = 0; d < t->levels; d++) {
-                t->node_count[d] = rd_u64le(p + off[k] + 8 * d);
-                uint64_t cap = d == 0 ? 1 : 8 * t->node_count[d - 1];
-                CHECK(t->node_count[d] <= cap, OCT_ETREE, off[k] + 8 * d);
-            }
-            CHECK(t->voxel_count <= 8 * t->node_count[t->levels - 1], OCT_ETREE,
-                  (uint64_t)OCT_OFF_VOXEL_COUNT);
+        if (k == OCT_SEC_LEVELS) {
+            oct_err rc = check_level_counts(p, off, t, where);
+            if (rc != OCT_OK)
+                return rc;
         }
     }
-    CHECK(known_minor ? size == end : size >= end, OCT_ESECTION, end); /* trailing bytes */
+    CHECK(lo->known_minor ? size == end : size >= end, OCT_ESECTION, end); /* trailing bytes */
+    return OCT_OK;
+}
 
-    /* Tree structure, then voxel records, surfaces and palette. */
-    oct_err rc = check_tree(p, off[OCT_SEC_NODES], off[OCT_SEC_LEVELS], t, where);
-    if (rc != OCT_OK)
-        return rc;
-    const unsigned char *v = p + off[OCT_SEC_VOXELS];
+/* Voxel records, surface indices and palette values in range. */
+static oct_err check_records(const unsigned char *p, const oct_tree *t, const layout *lo, uint64_t *where)
+{
+    const uint64_t voff = lo->off[OCT_SEC_VOXELS], soff = lo->off[OCT_SEC_SURFACES];
+    const uint64_t poff = lo->off[OCT_SEC_PALETTE];
+    const unsigned char *v = p + voff;
     for (uint64_t i = 0; i < t->voxel_count; i++)
-        CHECK(v[4 * i + 3] != 0x80, OCT_EVOXEL, off[OCT_SEC_VOXELS] + 4 * i + 3); /* offset -128 */
+        CHECK(v[4 * i + 3] != 0x80, OCT_EVOXEL, voff + 4 * i + 3); /* offset -128 */
     if (t->surface_count > 1) {
-        const unsigned char *s = p + off[OCT_SEC_SURFACES];
+        const unsigned char *s = p + soff;
         for (uint64_t i = 0; i < t->voxel_count; i++)
-            CHECK(s[i] < t->surface_count, OCT_EVOXEL, off[OCT_SEC_SURFACES] + i);
+            CHECK(s[i] < t->surface_count, OCT_EVOXEL, soff + i);
     }
     for (uint32_t i = 0; i < 3 * t->surface_count; i++) {
         float c;
-        memcpy(&c, p + off[OCT_SEC_PALETTE] + 4 * i, 4);
-        CHECK(isfinite(c) && c >= 0.0f && c <= 1.0f, OCT_EVOXEL, off[OCT_SEC_PALETTE] + 4 * i);
+        memcpy(&c, p + poff + 4 * i, 4);
+        CHECK(isfinite(c) && c >= 0.0f && c <= 1.0f, OCT_EVOXEL, poff + 4 * i);
     }
+    return OCT_OK;
+}
 
-    /* Checksums last: a damaged file is then reported by its first broken
-     * structure when it has one, and any other damage still fails here. */
-    if (!(flags & OCT_OPEN_TRUST)) {
-        CHECK((uint32_t)crc32_z(0, p, hsize - 4) == rd_u32le(p + hsize - 4), OCT_ECRC, hsize - 4);
-        for (int k = 0; k < OCT_SEC_COUNT; k++) {
-            uLong c = crc32_z(0, len[k] ? p + off[k] : NULL, (size_t)len[k]);
-            CHECK((uint32_t)c == rd_u32le(p + OCT_SEC_OFF(k) + 16), OCT_ECRC, (uint64_t)OCT_SEC_OFF(k) + 16);
-        }
+/* The header CRC, then each section's. */
+static oct_err check_crcs(const unsigned char *p, const layout *lo, uint64_t *where)
+{
+    const uint32_t hsize = lo->hsize;
+    CHECK((uint32_t)crc32_z(0, p, hsize - 4) == rd_u32le(p + hsize - 4), OCT_ECRC, hsize - 4);
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        uLong c = crc32_z(0, lo->len[k] ? p + lo->off[k] : NULL, (size_t)lo->len[k]);
+        CHECK((uint32_t)c == rd_u32le(p + OCT_SEC_OFF(k) + 16), OCT_ECRC, (uint64_t)OCT_SEC_OFF(k) + 16);
     }
+    return OCT_OK;
+}
 
-    /* The view. Sections are 64-byte aligned in a buffer at least 8-byte
-     * aligned, so the casts below are aligned. */
-    uint64_t g_off = off[OCT_SEC_NODES];
+/* The view of a validated file. Sections are 64-byte aligned in a buffer at
+ * least 8-byte aligned, so the casts below are aligned. */
+static void set_view(oct_file *f, const layout *lo)
+{
+    const unsigned char *p = f->data;
+    oct_tree *t = &f->tree;
+    oct_info *in = &f->info;
+    uint64_t g_off = lo->off[OCT_SEC_NODES];
     in->total_nodes = 0;
     for (uint32_t d = 0; d < t->levels; d++) {
         t->groups[d] = t->node_count[d] ? (const oct_group *)(const void *)(p + g_off) : NULL;
         g_off += 16 * groups_of(t->node_count[d]);
         in->total_nodes += t->node_count[d];
     }
-    t->voxels = t->voxel_count ? (const uint32_t *)(const void *)(p + off[OCT_SEC_VOXELS]) : NULL;
-    t->surfaces = t->surface_count > 1 && t->voxel_count ? p + off[OCT_SEC_SURFACES] : NULL;
-    t->palette = (const float *)(const void *)(p + off[OCT_SEC_PALETTE]);
-    in->file_size = size;
-    return OCT_OK;
+    t->voxels = t->voxel_count ? (const uint32_t *)(const void *)(p + lo->off[OCT_SEC_VOXELS]) : NULL;
+    t->surfaces = t->surface_count > 1 && t->voxel_count ? p + lo->off[OCT_SEC_SURFACES] : NULL;
+    t->palette = (const float *)(const void *)(p + lo->off[OCT_SEC_PALETTE]);
+    in->file_size = f->size;
+}
+
+/* Every check, in this order: header, sections, tree structure, records,
+ * then checksums last: a damaged file is then reported by its first broken
+ * structure when it has one, and any other damage still fails here. */
+static oct_err validate(oct_file *f, unsigned flags, uint64_t *where)
+{
+    const unsigned char *p = f->data;
+    oct_tree *t = &f->tree;
+    layout lo;
+    *where = 0;
+    oct_err rc = check_identity(p, f->size, &f->info, &lo, where);
+    if (rc == OCT_OK)
+        rc = check_header_fields(p, t, &f->info, where);
+    if (rc == OCT_OK)
+        rc = check_header_reserved(p, &lo, where);
+    if (rc == OCT_OK)
+        rc = check_sections(p, f->size, t, &lo, where);
+    if (rc == OCT_OK)
+        rc = check_tree(p, lo.off[OCT_SEC_NODES], lo.off[OCT_SEC_LEVELS], t, where);
+    if (rc == OCT_OK)
+        rc = check_records(p, t, &lo, where);
+    if (rc == OCT_OK && !(flags & OCT_OPEN_TRUST))
+        rc = check_crcs(p, &lo, where);
+    if (rc == OCT_OK)
+        set_view(f, &lo);
+    return rc;
 }
 
 static oct_err finish_open(oct_file *f, unsigned flags, oct_file **out, uint64_t *err_offset)

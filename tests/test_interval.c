@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include "common/expr/interval.h"
+#include "bench/rng.h"
 
 #ifdef __FAST_MATH__
 #error "fast-math breaks the interval arithmetic; build without it"
@@ -39,14 +40,8 @@ static int nbox(void)
 
 /* ---- random numbers (xorshift; deterministic) ---- */
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
-static uint64_t next_u64(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
-}
-static double unit(void) { return (double)(next_u64() >> 11) * 0x1p-53; }
+static uint64_t next_u64(void) { return rng_xorshift64(&rng); }
+static double unit(void) { return rng_unit(next_u64()); }
 
 static double special(void)
 {

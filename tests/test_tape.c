@@ -1,7 +1,9 @@
-/* Tests for common/expr/tape: point evaluation of every scene against
- * hand-written C, gradients against central differences, interval and
- * interval-gradient enclosures on the scenes and on random expression
- * trees, and pruning. Run from the repository root (reads scenes/). */
+/* Tests for common/expr/tape on the example scenes: point evaluation of
+ * every scene against hand-written C, gradients against central
+ * differences, interval and interval-gradient enclosures, the lane
+ * evaluator against the one-point one, and the rules for undefined points.
+ * Random trees and pruning are in test_tape_prune.c. Run from the
+ * repository root (reads scenes/). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,33 +17,7 @@
 
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
-
-#ifdef __FAST_MATH__
-#error "fast-math breaks the interval arithmetic; build without it"
-#endif
-
-#if defined(__SANITIZE_ADDRESS__)
-#define SCALE 10
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SCALE 10
-#endif
-#endif
-#ifndef SCALE
-#define SCALE 1
-#endif
-
-#define MAXSLOTS 4096
-
-static uint64_t rng = 0x2545f4914f6cdd1dull;
-static uint64_t next_u64(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
-}
-static double unit(void) { return (double)(next_u64() >> 11) * 0x1p-53; }
+#include "tests/test_tape_util.h"
 
 /* ---- the scenes in plain C ---------------------------------------------- */
 
@@ -281,22 +257,6 @@ static void test_gradient_vs_differences(void **state)
     }
 }
 
-/* v is enclosed by r (with the flag rules of interval.h). */
-static int encloses(interval r, unsigned flags, double v)
-{
-    if (interval_is_nan(r))
-        return flags != 0;
-    if (isnan(v))
-        return flags != 0;
-    return r.lo <= v && v <= r.hi;
-}
-
-static double in_box(interval b)
-{
-    double p = b.lo + unit() * (b.hi - b.lo);
-    return p < b.lo ? b.lo : p > b.hi ? b.hi : p;
-}
-
 static void rand_box(const scene *s, interval box[3])
 {
     double w = ldexp(1.0, -(int)(next_u64() % 24));
@@ -351,120 +311,6 @@ static void test_interval_scenes(void **state)
         }
         scene_free(s);
     }
-}
-
-/* ---- random expression trees --------------------------------------------- */
-
-static void gen(char **p, char *end, int depth)
-{
-    static const char *leaves[] = {"x", "y", "z", "0.78", "pi", "e", "2", "1.5", "0.5", "3", "0.1"};
-    static const char *un[] = {"exp", "log", "sqrt", "abs", "sin", "cos", "tan", "-"};
-    static const char *bin[] = {"+", "-", "*", "/", "min", "max", "^", "pow"};
-    if (end - *p < 200) {
-        *p += sprintf(*p, "x");
-        return;
-    }
-    uint64_t r = next_u64() % 10;
-    if (depth == 0 || r < 2) {
-        *p += sprintf(*p, "%s", leaves[next_u64() % (sizeof leaves / sizeof leaves[0])]);
-        return;
-    }
-    if (r < 5) {
-        const char *u = un[next_u64() % (sizeof un / sizeof un[0])];
-        *p += sprintf(*p, u[0] == '-' ? "-(" : "%s(", u);
-        gen(p, end, depth - 1);
-        *p += sprintf(*p, ")");
-        return;
-    }
-    const char *b = bin[next_u64() % (sizeof bin / sizeof bin[0])];
-    if (b[0] == '^') {
-        static const char *ex[] = {"2", "3", "4", "-1", "-2", "0.5", "1.5", "y", "5"};
-        *p += sprintf(*p, "(");
-        gen(p, end, depth - 1);
-        *p += sprintf(*p, ")^%s", ex[next_u64() % (sizeof ex / sizeof ex[0])]);
-    } else if (b[0] >= 'a') {
-        *p += sprintf(*p, "%s(", b);
-        gen(p, end, depth - 1);
-        *p += sprintf(*p, ", ");
-        gen(p, end, depth - 1);
-        if (b[1] != 'o' && next_u64() % 3 == 0) {
-            *p += sprintf(*p, ", ");
-            gen(p, end, depth - 1);
-        }
-        *p += sprintf(*p, ")");
-    } else {
-        *p += sprintf(*p, "(");
-        gen(p, end, depth - 1);
-        *p += sprintf(*p, ") %s (", b);
-        gen(p, end, depth - 1);
-        *p += sprintf(*p, ")");
-    }
-}
-
-/* A random scene whose surface is a random tree of depth <= 6. */
-static scene *rand_tree(char *text, size_t n)
-{
-    for (;;) {
-        char *p = text + sprintf(text, "bounds -4 -4 -4 4 4 4\nsurface ");
-        gen(&p, text + n, 1 + (int)(next_u64() % 6));
-        *p++ = '\n';
-        scene *s = NULL;
-        scene_error e;
-        if (scene_parse(text, (size_t)(p - text), &s, &e) == 0)
-            return s;
-        /* Only constant sub-trees that are undefined may be refused. */
-        if (!strstr(e.message, "constant expression") && !strstr(e.message, "exponent"))
-            fail_msg("%s: %s", text, e.message);
-    }
-}
-
-static void rand_tree_box(interval box[3])
-{
-    for (int a = 0; a < 3; a++) {
-        double c = (unit() - 0.5) * 8, w = 8 * ldexp(unit(), -(int)(next_u64() % 30));
-        box[a].lo = c;
-        box[a].hi = next_u64() % 10 == 0 ? c : c + w;
-    }
-}
-
-static void test_random_trees(void **state)
-{
-    (void)state;
-    static char text[16384];
-    static interval slots[MAXSLOTS];
-    static tape_insn pruned_insn[MAXSLOTS];
-    static uint32_t scratch[MAXSLOTS];
-    double d1[MAXSLOTS], d2[MAXSLOTS];
-    long points = 0, pruned_shorter = 0;
-    for (int n = 0; n < 3000 / SCALE; n++) {
-        scene *s = rand_tree(text, sizeof text);
-        const tape *t = &s->surfaces[0].tape;
-        for (int b = 0; b < 30; b++) {
-            interval box[3];
-            rand_tree_box(box);
-            unsigned f;
-            interval r = tape_eval_interval(t, box, slots, &f);
-            tape pt;
-            uint32_t len = tape_prune(t, slots, f, pruned_insn, scratch, &pt);
-            assert_true(len <= t->n && len >= 1);
-            pruned_shorter += len < t->n;
-            for (int w = 0; w < 10; w++) {
-                double p[3] = {in_box(box[0]), in_box(box[1]), in_box(box[2])};
-                double v = tape_eval(t, p[0], p[1], p[2], d1);
-                points++;
-                if (!encloses(r, f, v))
-                    fail_msg("%s box [%a,%a]x[%a,%a]x[%a,%a]: f(%a,%a,%a) = %a outside [%a, %a] "
-                             "(flags %u)", text, box[0].lo, box[0].hi, box[1].lo, box[1].hi,
-                             box[2].lo, box[2].hi, p[0], p[1], p[2], v, r.lo, r.hi, f);
-                double pv = tape_eval(&pt, p[0], p[1], p[2], d2);
-                if (!(pv == v || (isnan(pv) && isnan(v))))
-                    fail_msg("%s: pruned %.17g, full %.17g", text, pv, v);
-            }
-        }
-        scene_free(s);
-    }
-    assert_true(points > 0);
-    assert_true(pruned_shorter > 0);
 }
 
 /* Bitwise equality, NaN equal to NaN. */
@@ -526,132 +372,6 @@ static void test_grad_lanes(void **state)
     }
 }
 
-/* tape_prune_const on random trees with an aggressive tolerance: on random
- * sub-boxes, the pruned tape's interval and mean-value enclosures must still
- * hold the full tape's values. */
-static void test_prune_const_stays_sound(void **state)
-{
-    (void)state;
-    static char text[16384];
-    static interval slots[MAXSLOTS];
-    static tape_insn pruned_insn[MAXSLOTS];
-    static tape_const pruned_konst[2 * MAXSLOTS];
-    static uint32_t scratch[MAXSLOTS];
-    static tape_idual islots[MAXSLOTS];
-    double d1[MAXSLOTS];
-    long checked = 0, replaced = 0;
-    for (int n = 0; n < 2000 / SCALE; n++) {
-        scene *s = rand_tree(text, sizeof text);
-        const tape *t = &s->surfaces[0].tape;
-        assert_true(t->nconst + t->n <= 2 * MAXSLOTS);
-        for (int b = 0; b < 20; b++) {
-            interval box[3];
-            rand_tree_box(box);
-            unsigned f;
-            interval r = tape_eval_interval(t, box, slots, &f);
-            tape pt;
-            double tiny = 0.05 * (r.hi - r.lo);
-            tape_prune_const(t, slots, f, isfinite(tiny) ? tiny : -1.0, pruned_insn, pruned_konst,
-                             scratch, &pt);
-            replaced += pt.nconst > t->nconst;
-            for (int sb = 0; sb < 4; sb++) {
-                interval sub[3];
-                double c[3];
-                for (int a = 0; a < 3; a++) {
-                    double u = in_box(box[a]), v = in_box(box[a]);
-                    sub[a].lo = u < v ? u : v;
-                    sub[a].hi = u < v ? v : u;
-                    c[a] = 0.5 * (sub[a].lo + sub[a].hi);
-                }
-                unsigned pf = 0, gf = 0, cf = 0;
-                interval pr = tape_eval_interval(&pt, sub, slots, &pf);
-                interval g[3], cb[3] = {{c[0], c[0]}, {c[1], c[1]}, {c[2], c[2]}};
-                tape_eval_interval_grad(&pt, sub, g, islots, &gf);
-                interval fc = tape_eval_interval(&pt, cb, slots, &cf);
-                for (int w = 0; w < 5; w++) {
-                    double p[3] = {in_box(sub[0]), in_box(sub[1]), in_box(sub[2])};
-                    double v = tape_eval(t, p[0], p[1], p[2], d1);
-                    if (isnan(v) || isinf(v))
-                        continue;
-                    checked++;
-                    if (!encloses(pr, pf, v))
-                        fail_msg("%s: pruned interval [%a, %a] misses f = %a", text, pr.lo, pr.hi, v);
-                    if (gf || cf || interval_is_nan(fc))
-                        continue;
-                    unsigned mf = 0;
-                    interval mv = fc;
-                    for (int a = 0; a < 3; a++) {
-                        interval off = {interval_next_down(p[a] - c[a]), interval_next_up(p[a] - c[a])};
-                        mv = interval_add(mv, interval_mul(g[a], off, &mf), &mf);
-                    }
-                    if (!mf && !(mv.lo <= v && v <= mv.hi))
-                        fail_msg("%s: pruned mean-value form [%a, %a] misses f = %a", text, mv.lo,
-                                 mv.hi, v);
-                }
-            }
-        }
-        scene_free(s);
-    }
-    assert_true(checked > 1000);
-    assert_true(replaced > 0);
-}
-
-/* A far blob over the unit box is a constant to within 1e-40: it goes. */
-static void test_prune_const_drops_far_terms(void **state)
-{
-    (void)state;
-    static const char text[] = "bounds 0 0 0 1 1 1\nsurface exp(-((x-20)^2 + y^2)) + x^2 + y - 0.5\n";
-    scene *s = NULL;
-    scene_error e;
-    assert_int_equal(scene_parse(text, sizeof text - 1, &s, &e), 0);
-    const tape *t = &s->surfaces[0].tape;
-    interval slots[64], box[3] = {{0, 1}, {0, 1}, {0, 1}};
-    tape_insn out[64];
-    tape_const konst[128];
-    uint32_t scratch[64];
-    unsigned f;
-    tape_eval_interval(t, box, slots, &f);
-    tape pt;
-    uint32_t n = tape_prune_const(t, slots, f, 1e-30, out, konst, scratch, &pt);
-    assert_true(n + 5 <= t->n); /* the exp and its argument's arithmetic are gone */
-    double d[64];
-    assert_true(fabs(tape_eval(&pt, 0.5, 0.25, 0.0, d) - (0.25 + 0.25 - 0.5)) < 1e-30);
-    /* With no tolerance nothing but dead code goes. */
-    assert_int_equal(tape_prune_const(t, slots, f, -1.0, out, konst, scratch, &pt), t->n);
-    scene_free(s);
-}
-
-static void test_prune(void **state)
-{
-    (void)state;
-    static const char text[] = "bounds 0 0 0 1 1 1\nsurface min(x, y + 10, max(z, z^2 - 5)) + sin(x)\n";
-    scene *s = NULL;
-    scene_error e;
-    assert_int_equal(scene_parse(text, sizeof text - 1, &s, &e), 0);
-    const tape *t = &s->surfaces[0].tape;
-    interval slots[64], box[3] = {{0, 1}, {0, 1}, {0, 1}};
-    tape_insn out[64];
-    uint32_t scratch[64];
-    unsigned f;
-    tape_eval_interval(t, box, slots, &f);
-    tape pt;
-    uint32_t n = tape_prune(t, slots, f, out, scratch, &pt);
-    /* min(min(x, y+10), max(z, z^2-5)) becomes min(x, z): x, z, min, sin, add. */
-    assert_true(t->n > 9);
-    assert_int_equal(n, 5);
-    double d[64];
-    assert_true(tape_eval(&pt, 0.5, 0.2, 0.3, d) == 0.3 + sin(0.5));
-    /* Pruning a pruned tape again is fine, and NULL slots only drop dead code. */
-    tape_insn out2[64];
-    tape pt2;
-    assert_int_equal(tape_prune(&pt, NULL, 0, out2, scratch, &pt2), 5);
-    /* On a box where the operands overlap nothing is dropped. */
-    interval wide[3] = {{-20, 20}, {-20, 20}, {-20, 20}};
-    tape_eval_interval(t, wide, slots, &f);
-    assert_int_equal(tape_prune(t, slots, f, out, scratch, &pt), t->n);
-    scene_free(s);
-}
-
 /* Documented rules for undefined points (TESTPLAN 23, 24). */
 static void test_undefined_points(void **state)
 {
@@ -687,11 +407,7 @@ int main(void)
         cmocka_unit_test(test_surfaces_inside_bounds),
         cmocka_unit_test(test_gradient_vs_differences),
         cmocka_unit_test(test_interval_scenes),
-        cmocka_unit_test(test_random_trees),
         cmocka_unit_test(test_grad_lanes),
-        cmocka_unit_test(test_prune),
-        cmocka_unit_test(test_prune_const_stays_sound),
-        cmocka_unit_test(test_prune_const_drops_far_terms),
         cmocka_unit_test(test_undefined_points),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

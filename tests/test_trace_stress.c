@@ -37,7 +37,8 @@
 #include <string.h>
 
 #include "render/trace.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
+#include "tests/trace_oracle.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SANITIZED 1
@@ -57,15 +58,8 @@
 
 #define FRAC_BITS 16 /* o is a multiple of 2^-FRAC_BITS */
 
-/* xorshift64*: deterministic */
 static uint64_t rng_state = 0x243f6a8885a308d3u;
-static uint64_t rng(void)
-{
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return rng_state * 0x2545f4914f6cdd1dULL;
-}
+static uint64_t rng(void) { return rng_xorshift64star(&rng_state); }
 static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
 
@@ -474,7 +468,7 @@ static void check_exact(const oct_tree *t, const uint32_t (*vox)[3], size_t n, c
     for (unsigned k = k_lo; k <= k_hi; k++) {
         trace_opts opts = {k, 0};
         trace_hit h;
-        trace_ray_cast(t, &opts, eye, dir, &h);
+        trace_cast_all(t, &opts, eye, dir, &h);
         st->traces++;
         if (h.steps > st->max_steps_seen)
             st->max_steps_seen = h.steps;
@@ -688,7 +682,7 @@ static void test_general_rays_tolerance(void **state)
             for (unsigned k = k0; k <= levels; k += kstep) {
                 trace_opts opts = {k, 0};
                 trace_hit h;
-                trace_ray_cast(t, &opts, eye, dir, &h);
+                trace_cast_all(t, &opts, eye, dir, &h);
                 st.traces++;
                 st.aimed_traces += aimed;
                 assert_true(h.steps <= trace_max_steps(levels));
@@ -830,8 +824,8 @@ static void shoot_at_shell(const oct_tree *t, const uint32_t (*v)[3], size_t n, 
         for (unsigned k = 0; k <= t->levels; k++) {
             trace_opts o = {k, 0};
             trace_hit hin, hout;
-            trace_ray_cast(t, &o, eye, dir, &hin);
-            trace_ray_cast(t, &o, far, back, &hout);
+            trace_cast_all(t, &o, eye, dir, &hin);
+            trace_cast_all(t, &o, far, back, &hout);
             if (!hin.hit || !hout.hit)
                 fail_msg("hole: L=%u K=%u aim (%.17g %.17g %.17g) from %s", t->levels, k, P[0],
                          P[1], P[2], hin.hit ? "outside" : "inside");
@@ -909,17 +903,17 @@ static void test_step_bound(void **state)
         const double eye[3] = {0, 0, 0}, dir[3] = {1, 1 - 0x1p-30, 1 - 0x1p-29};
         trace_opts o = {0, 0};
         trace_hit h;
-        assert_int_equal(trace_ray_cast(t, &o, eye, dir, &h), 1);
+        assert_int_equal(trace_cast_all(t, &o, eye, dir, &h), 1);
         assert_true(h.steps <= trace_max_steps(levels));
         assert_int_equal(h.steps, 3 * (lim - 1)); /* every plane crossed separately */
         /* exactly diagonal: one step per voxel */
         const double diag[3] = {1, 1, 1};
-        assert_int_equal(trace_ray_cast(t, &o, eye, diag, &h), 1);
+        assert_int_equal(trace_cast_all(t, &o, eye, diag, &h), 1);
         assert_int_equal(h.steps, lim - 1);
         tree_util_free(t);
         /* empty tree: returns at once */
         t = tree_util_simple(levels, NULL, 0);
-        assert_int_equal(trace_ray_cast(t, &o, eye, dir, &h), 0);
+        assert_int_equal(trace_cast_all(t, &o, eye, dir, &h), 0);
         assert_int_equal(h.steps, 0);
         tree_util_free(t);
     }

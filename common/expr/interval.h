@@ -1,5 +1,6 @@
 /* interval: sound interval arithmetic in double, with outward rounding by
- * nextafter, for the operations of the scene language. */
+ * bit steps (interval_next_up / interval_next_down), for the operations of
+ * the scene language. */
 #ifndef INTERVAL_H
 #define INTERVAL_H
 
@@ -12,10 +13,12 @@
  * encloses nothing useful and callers must treat it as "anything".
  *
  * Rounding. Every operation whose double result may be inexact widens it
- * outward with nextafter: one ulp for + - * / sqrt (IEEE 754 rounds these
- * correctly, so the true value is within half an ulp), two ulps for the libm
- * functions exp log sin cos tan pow (glibc documents at most 1-2 ulp for
- * these; see also the MPFR cross-checks in tests/test_interval.c). We do not
+ * outward, the lower end down and the upper end up, by steps of at least
+ * one ulp (interval_next_down / interval_next_up): one step for + - * /
+ * sqrt (IEEE 754 rounds these correctly, so the true value is within half
+ * an ulp), two steps for the libm functions exp log sin cos tan pow (glibc
+ * documents at most 1-2 ulp for these; see also the MPFR cross-checks in
+ * tests/test_interval.c). Each operation below states its rounding. We do not
  * use fesetround: it needs -frounding-math to stop the compiler from folding
  * and moving floating-point code across the mode switch, it is slow to toggle,
  * it is per-thread state, and it says nothing about libm's accuracy anyway.
@@ -33,30 +36,41 @@ typedef struct interval {
 
 enum { INTERVAL_MAYBE_NAN = 1u };
 
-/* True when i is the NaN interval. */
-/* The NaN interval. */
-/* [lo, hi] widened by one ulp each way unless lo == hi is exact: used for
- * constants such as 0.78 or pi that a double cannot hold. */
+/* ---- Out-of-line part (interval.c): the rarer and libm operations. ---- */
+
+/* [next_down(v), next_up(v)]: one step each way, always. For a constant
+ * such as 0.78 or pi that the double v only approximates; the parser makes
+ * an exact literal [v, v] itself instead. */
 interval interval_around(double v);
 
-/* Division by an interval that touches 0 gives [-inf, inf]. */
+/* a / b, the quotient ends rounded one step outward. A divisor that touches
+ * 0 gives [-inf, inf] (flagged when a touches 0 too: 0/0). */
 interval interval_div(interval a, interval b, unsigned *flags);
-/* a*a, tight: [-2,3]^2 = [0,9]. */
+/* sqrt(a), ends rounded one step outward, the lower end clamped at 0. The
+ * negative part of a is flagged and dropped; all of a negative is NaN. */
 interval interval_sqrt(interval a, unsigned *flags);
-/* Overflow gives +inf, never NaN. */
+/* exp(a), ends rounded two steps outward. Overflow gives +inf, never NaN;
+ * subnormal ends widen to 0 (lower) and DBL_MIN (upper). */
 interval interval_exp(interval a, unsigned *flags);
-/* log(0) = -inf (a value, not NaN), log of a negative = NaN. */
+/* log(a), ends rounded two steps outward. log(0) = -inf (a value, not NaN);
+ * the negative part of a is flagged and dropped; all of a negative is NaN. */
 interval interval_log(interval a, unsigned *flags);
+/* sin(a) and cos(a): ends rounded two steps outward, then clamped to
+ * [-1, 1]; an extremum inside a sets that end to 1 or -1. With an end
+ * beyond |1e8|, or 6 wide or more, the result is [-1, 1]. */
 interval interval_sin(interval a, unsigned *flags);
 interval interval_cos(interval a, unsigned *flags);
-/* Across a pole (or wider than pi) gives [-inf, inf]. */
+/* tan(a), ends rounded two steps outward. Across a pole, 3 wide or more,
+ * or with an end beyond |1e8|, the result is [-inf, inf]. */
 interval interval_tan(interval a, unsigned *flags);
 /* a^p for a constant non-integer p (finite): defined for a >= 0 only,
- * pow(0, p<0) = +inf. Integer powers are multiplications (see tape.h). */
+ * pow(0, p<0) = +inf. Ends rounded two steps outward, the lower clamped at
+ * 0. Integer powers are multiplications (see tape.h). */
 interval interval_powc(interval a, double p, unsigned *flags);
-/* Smallest interval holding both. NaN interval if either is NaN. */
 
-/* ---- Inline part: the cheap operations the evaluators call most. ---- */
+/* ---- Inline part: the cheap operations the evaluators call most. ----
+ * Names with a double underscore are internal helpers, not for use outside
+ * interval.[ch]. */
 
 /* Inlined even where the compiler would rather call: a call costs as much
  * as the operation in the evaluators' loops. */
@@ -94,7 +108,8 @@ static inline double interval__down_finite(double x)
     return x;
 }
 
-/* The same for any x: NaN and +inf (-inf) stay. */
+/* One outward step for any x: interval__up_finite (interval__down_finite)
+ * for a finite x; NaN and +inf (-inf) stay. */
 static inline double interval_next_up(double x)
 {
     return x < INFINITY ? interval__up_finite(x) : x;
@@ -104,7 +119,6 @@ static inline double interval_next_down(double x)
     return x > -INFINITY ? interval__down_finite(x) : x;
 }
 
-/* Internal helpers (double underscore): not for use outside interval.[ch]. */
 static inline double interval__min2(double a, double b) { return a < b ? a : b; } /* no NaN */
 static inline double interval__max2(double a, double b) { return a > b ? a : b; }
 static inline int interval__has_zero(interval a) { return a.lo <= 0.0 && a.hi >= 0.0; }
@@ -123,7 +137,8 @@ static inline int interval_is_nan(interval i) { return interval__isnan(i); }
 /* The NaN interval. */
 static inline interval interval_nan(void) { return interval__mk(NAN, NAN); }
 
-/* Smallest interval holding both. NaN interval if either is NaN. */
+/* Smallest interval holding both, exact (no rounding). NaN interval if
+ * either is NaN. */
 static inline interval interval_hull(interval a, interval b)
 {
     if (interval__isnan(a) || interval__isnan(b))
@@ -131,6 +146,7 @@ static inline interval interval_hull(interval a, interval b)
     return interval__mk(a.lo < b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
 }
 
+/* -a, exact (no rounding). */
 static inline interval interval_neg(interval a) { return interval__mk(-a.hi, -a.lo); }
 
 /* The ends of a finite sum s = x + y, rounded outward as interval_add
@@ -149,6 +165,9 @@ static inline double interval__sum_up(double s, double x, double y)
     return s == 0.0 && x == -y ? s : interval__up_finite(s);
 }
 
+/* a + b, ends rounded one step outward, except that an exact zero end
+ * (x + -x) stays 0. -inf + inf inside the box is flagged, and that end
+ * becomes infinite. */
 INTERVAL_INLINE interval interval_add(interval a, interval b, unsigned *flags)
 {
     double flo = a.lo + b.lo, fhi = a.hi + b.hi;
@@ -179,6 +198,7 @@ INTERVAL_INLINE interval interval_add(interval a, interval b, unsigned *flags)
                         hi == 0.0 && a.hi == -b.hi ? hi : interval_next_up(hi));
 }
 
+/* a - b, as interval_add(a, -b): the same rounding. */
 INTERVAL_INLINE interval interval_sub(interval a, interval b, unsigned *flags)
 {
     return interval_add(a, interval_neg(b), flags);
@@ -197,6 +217,9 @@ static inline double interval__mul0(double x, double y, int *bad)
     return p;
 }
 
+/* a * b, ends rounded one step outward, except that a zero end coming from
+ * a zero factor stays 0. 0 * inf inside the box is flagged and counts as 0
+ * for the ends. */
 INTERVAL_INLINE interval interval_mul(interval a, interval b, unsigned *flags)
 {
     /* Fast path, same result: when neither factor holds 0 (nor is NaN), the
@@ -257,7 +280,8 @@ INTERVAL_INLINE interval interval_mul(interval a, interval b, unsigned *flags)
                         hi == 0.0 && !underflow ? 0.0 : interval_next_up(hi));
 }
 
-/* a*a, tight: [-2,3]^2 = [0,9]. */
+/* a*a, tight: [-2,3]^2 = [0,9]. Ends rounded one step outward, the lower
+ * end clamped at 0. */
 INTERVAL_INLINE interval interval_sqr(interval a, unsigned *flags)
 {
     if (interval__isnan(a))
@@ -278,6 +302,7 @@ INTERVAL_INLINE interval interval_sqr(interval a, unsigned *flags)
     return interval__mk(l < 0.0 ? 0.0 : l, interval_next_up(h));
 }
 
+/* |a|, exact (no rounding). */
 static inline interval interval_abs(interval a)
 {
     if (a.lo >= 0.0)
@@ -287,6 +312,8 @@ static inline interval interval_abs(interval a)
     return interval__mk(0.0, -a.lo > a.hi ? -a.lo : a.hi);
 }
 
+/* Elementwise min and max of the ends, exact (no rounding); NaN interval
+ * if either is NaN. */
 static inline interval interval_min(interval a, interval b)
 {
     if (interval__isnan(a) || interval__isnan(b))

@@ -1,5 +1,8 @@
 /* tape: an implicit function compiled to a flat SSA instruction array, and
- * its evaluators (point, gradient, interval, interval gradient) and pruner. */
+ * its evaluators (point, gradient, interval, interval gradient) and pruner.
+ * Built in tape_build.c, pruned in tape_prune.c, evaluated in tape_eval.c
+ * (point, gradient), tape_lanes.c (gradient over several points) and
+ * tape_eval_interval.c (interval, interval gradient). */
 #ifndef TAPE_H
 #define TAPE_H
 

@@ -1,4 +1,4 @@
-/* tape_lanes: the point-gradient evaluator of tape.c run over up to
+/* tape_lanes: the point-gradient evaluator of tape_eval.c run over up to
  * TAPE_LANES points per pass. Each lane performs exactly the operations of
  * tape_eval_grad, in the same order (no contraction: -ffp-contract=off), so
  * the results are the same bits; what changes is that the dispatch on the
@@ -8,10 +8,9 @@
 #include <math.h>
 #include <string.h>
 
-#define L TAPE_LANES
+#include "common/expr/tape_int.h"
 
-static double point_min(double a, double b) { return (a < b || a != a) ? a : b; }
-static double point_max(double a, double b) { return (a > b || a != a) ? a : b; }
+#define L TAPE_LANES
 
 /* Lanes from n on take lane 0's value (their points repeat lane 0's). */
 static void fill(double *v, unsigned n)

@@ -1,8 +1,8 @@
-/* oct_testutil: random sparse voxel trees for the .oct tests and the fuzz
- * corpus generator: Morton-sorted voxels, their masks per depth, and the
- * bytes the writer makes of them. */
-#ifndef OCT_TESTUTIL_H
-#define OCT_TESTUTIL_H
+/* oct_synth: random sparse voxel trees for the .oct tests, the fuzz corpus
+ * generator and the validation benchmark: Morton-sorted voxels, their masks
+ * per depth, and the bytes the writer makes of them. */
+#ifndef OCT_SYNTH_H
+#define OCT_SYNTH_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -40,7 +40,7 @@ oct_err test_tree_write(const test_tree *t, unsigned char **buf, size_t *len);
  * header's own offsets and skips any section outside the buffer. */
 void test_oct_refresh_crcs(unsigned char *buf, size_t len);
 
-/* xorshift64* */
+/* xorshift64* (bench/rng.h); a zero *state starts from a fixed seed. */
 uint64_t test_rand(uint64_t *state);
 
 #endif

@@ -1,8 +1,9 @@
-/* oct_testutil: random sparse voxel trees and writer round trips for tests. */
-#include "tests/oct_testutil.h"
+/* oct_synth: random sparse voxel trees and writer round trips for tests and benchmarks. */
+#include "bench/oct_synth.h"
 
 #include "format/oct_layout.h"
 #include "format/oct_normal.h"
+#include "bench/rng.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -11,12 +12,9 @@
 
 uint64_t test_rand(uint64_t *s)
 {
-    uint64_t x = *s ? *s : 0x9e3779b97f4a7c15u;
-    x ^= x >> 12;
-    x ^= x << 25;
-    x ^= x >> 27;
-    *s = x;
-    return x * UINT64_C(0x2545f4914f6cdd1d);
+    if (!*s)
+        *s = 0x9e3779b97f4a7c15u;
+    return rng_xorshift64star(s);
 }
 
 static void *xmalloc(size_t n)

@@ -1,0 +1,118 @@
+/* tape_prune: dead-code removal and pruning of a tape for a box, from the
+ * interval enclosures of its slots over that box. */
+#include "common/expr/tape.h"
+
+#include <string.h>
+
+#define EMPTY UINT32_MAX
+
+/* Marks in m the instructions the value of `root` depends on: m[i] = i when
+ * live, EMPTY when dead, w when instruction i is replaced by instruction w (a
+ * decided min/max), CONSTANT when it is replaced by its enclosure s[i] (an
+ * interval narrower than `tiny`: see tape_prune_const). s may be NULL: then
+ * only dead code goes. */
+#define CONSTANT (EMPTY - 1)
+static void mark(const tape_insn *in, uint32_t n, uint32_t root, const interval *s, double tiny,
+                 uint32_t *m)
+{
+    for (uint32_t i = 0; i < n; i++)
+        m[i] = EMPTY;
+    m[root] = root;
+    for (uint32_t i = root + 1; i-- > 0;) {
+        if (m[i] == EMPTY)
+            continue;
+        uint32_t op = in[i].op, a = in[i].a, c = in[i].b;
+        if (op == TAPE_CONST || op <= TAPE_Z)
+            continue;
+        if (s && i != root && s[i].hi - s[i].lo <= tiny) { /* NaN or inf: the test fails */
+            m[i] = CONSTANT;
+            continue;
+        }
+        if (s && (op == TAPE_MIN || op == TAPE_MAX)) {
+            /* Strict comparisons: equal values could differ in the sign of 0. */
+            int a_lower = s[a].hi < s[c].lo, c_lower = s[c].hi < s[a].lo;
+            uint32_t w = EMPTY;
+            if (op == TAPE_MIN)
+                w = a_lower ? a : c_lower ? c : EMPTY;
+            else
+                w = a_lower ? c : c_lower ? a : EMPTY;
+            if (w != EMPTY) {
+                m[i] = w;
+                if (m[w] == EMPTY)
+                    m[w] = w;
+                continue;
+            }
+        }
+        if (m[a] == EMPTY)
+            m[a] = a;
+        if (op >= TAPE_ADD && op != TAPE_POWC && m[c] == EMPTY)
+            m[c] = c;
+    }
+}
+
+/* Emits the live instructions renumbered; returns the count and sets *root.
+ * An instruction marked CONSTANT becomes a constant whose enclosure is s[i],
+ * appended to `konst` at *nconst. */
+static uint32_t compact(const tape_insn *in, uint32_t n, uint32_t *root, uint32_t *m, tape_insn *out,
+                        const interval *s, tape_const *konst, uint32_t *nconst)
+{
+    uint32_t k = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        if (m[i] == EMPTY)
+            continue;
+        if (m[i] == CONSTANT) {
+            tape_const c = {0.5 * s[i].lo + 0.5 * s[i].hi, s[i].lo, s[i].hi};
+            konst[*nconst] = c;
+            out[k].op = TAPE_CONST;
+            out[k].a = (*nconst)++;
+            out[k].b = 0;
+            m[i] = k++;
+            continue;
+        }
+        if (m[i] != i) {
+            m[i] = m[m[i]]; /* already renumbered, as m[i] < i */
+            continue;
+        }
+        tape_insn t = in[i];
+        if (t.op != TAPE_CONST && t.op > TAPE_Z) {
+            t.a = m[t.a];
+            if (t.op >= TAPE_ADD && t.op != TAPE_POWC)
+                t.b = m[t.b];
+        }
+        out[k] = t;
+        m[i] = k++;
+    }
+    *root = m[*root];
+    return k;
+}
+
+uint32_t tape_prune(const tape *t, const interval *slots, unsigned flags, tape_insn *out_insn,
+                    uint32_t *scratch, tape *out)
+{
+    uint32_t root = t->root;
+    mark(t->insn, t->n, root, flags ? NULL : slots, -1.0, scratch);
+    uint32_t n = compact(t->insn, t->n, &root, scratch, out_insn, NULL, NULL, NULL);
+    out->insn = out_insn;
+    out->n = n;
+    out->root = root;
+    out->konst = t->konst;
+    out->nconst = t->nconst;
+    out->owned = 0;
+    return n;
+}
+
+uint32_t tape_prune_const(const tape *t, const interval *slots, unsigned flags, double tiny,
+                          tape_insn *out_insn, tape_const *out_konst, uint32_t *scratch, tape *out)
+{
+    uint32_t root = t->root, nconst = t->nconst;
+    mark(t->insn, t->n, root, flags ? NULL : slots, flags ? -1.0 : tiny, scratch);
+    memcpy(out_konst, t->konst, t->nconst * sizeof *out_konst);
+    uint32_t n = compact(t->insn, t->n, &root, scratch, out_insn, slots, out_konst, &nconst);
+    out->insn = out_insn;
+    out->n = n;
+    out->root = root;
+    out->konst = out_konst;
+    out->nconst = nconst;
+    out->owned = 0;
+    return n;
+}

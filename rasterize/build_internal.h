@@ -1,0 +1,218 @@
+/* build_internal: what the files of the octree build share (private to
+ * rasterize/). build_ctx is the read-only context of one build, worker the
+ * scratch of one thread, task_out what one task hands to the writer. The
+ * small helpers that cross files are static inline here so the hot paths
+ * inline them as they did within one file. */
+#ifndef BUILD_INTERNAL_H
+#define BUILD_INTERNAL_H
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/expr/interval.h"
+#include "common/expr/tape.h"
+#include "rasterize/build.h"
+
+/* fmin and fmax without the library call; a NaN a gives b. */
+static inline double min2(double a, double b) { return a < b ? a : b; }
+static inline double max2(double a, double b) { return a > b ? a : b; }
+
+/* --- growable buffers -------------------------------------------------- */
+
+typedef struct buf {
+    uint8_t *p;
+    size_t n, cap; /* in bytes */
+} buf;
+
+static inline int buf_push(buf *b, const void *data, size_t n)
+{
+    if (b->n + n > b->cap) {
+        size_t cap = b->cap ? b->cap * 2 : 256;
+        while (cap < b->n + n)
+            cap *= 2;
+        uint8_t *p = realloc(b->p, cap);
+        if (!p)
+            return -1;
+        b->p = p;
+        b->cap = cap;
+    }
+    memcpy(b->p + b->n, data, n);
+    b->n += n;
+    return 0;
+}
+
+static inline void buf_free(buf *b)
+{
+    free(b->p);
+    memset(b, 0, sizeof *b);
+}
+
+/* --- shared, read-only context ----------------------------------------- */
+
+typedef struct build_ctx {
+    const scene *sc;
+    const build_params *par;
+    unsigned levels, nsurf, task_depth;
+    double origin[3], edge;
+    double cell_edge[OCT_MAX_LEVELS + 1]; /* edge / 2^depth, exact (a power-of-two scaling) */
+    double bmax[3];            /* bounds' max corner: cells are clipped to it */
+    const tape **full;         /* full tape of each surface */
+    uint32_t *tape_off;        /* offset of each surface's prune buffer */
+    uint32_t tape_total;       /* sum of tape lengths */
+    uint32_t *konst_off;       /* offset of each surface's pruned constant pool */
+    uint32_t konst_total;      /* sum of (constants + instructions) over the surfaces */
+    uint32_t max_len;
+    const build_shard *shard;  /* NULL: the whole grid */
+} build_ctx;
+
+/* build.c: the context of a build with parameters p (p->levels, method,
+ * shard; threads unused); -1 when memory runs out. build_ctx_free releases
+ * it, also after a failed build_ctx_init. */
+int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p);
+void build_ctx_free(build_ctx *c);
+
+/* The Morton code of a cell at depth (its coordinates' bits interleaved,
+ * x lowest). */
+static inline uint64_t morton_encode(const uint64_t cell[3], unsigned depth)
+{
+    uint64_t m = 0;
+    for (unsigned b = 0; b < depth; b++)
+        m |= ((cell[0] >> b) & 1) << (3 * b) | ((cell[1] >> b) & 1) << (3 * b + 1) |
+             ((cell[2] >> b) & 1) << (3 * b + 2);
+    return m;
+}
+
+/* Whether the cell (depth, cell) holds part of the shard's piece: a cell at
+ * or above the shard depth when its descendants there meet [lo, hi), a
+ * deeper one when its ancestor there lies in it. Always 1 without a shard. */
+static inline int shard_meets(const build_ctx *c, unsigned depth, const uint64_t cell[3])
+{
+    const build_shard *sh = c->shard;
+    if (!sh)
+        return 1;
+    uint64_t m = morton_encode(cell, depth), first, end;
+    if (depth <= sh->depth) {
+        first = m << (3 * (sh->depth - depth));
+        end = (m + 1) << (3 * (sh->depth - depth));
+    } else {
+        first = m >> (3 * (depth - sh->depth));
+        end = first + 1;
+    }
+    return first < sh->hi && end > sh->lo;
+}
+
+/* What one task produced: the subtree below one depth-S cell. */
+typedef struct task_out {
+    buf masks[OCT_MAX_LEVELS];
+    buf voxels, surfaces;
+    int nonempty;
+    int done;
+} task_out;
+
+/* --- per-thread state --------------------------------------------------- */
+
+typedef struct worker {
+    const build_ctx *c;
+    interval *slots, *slots2;
+    tape_idual *islots;
+    tape_dual *dslots;
+    tape_dual_lanes *lslots;
+    uint32_t *scratch;
+    tape_insn *prune;      /* [(levels + 2) * tape_total] */
+    tape_const *prune_konst; /* [(levels + 2) * konst_total] */
+    tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
+    uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
+    unsigned *nact;        /* [levels + 2] */
+    interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
+    double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */
+    uint8_t *cf_ok;        /* [nsurf]: cf holds them for that surface (voxel_surface clears) */
+    double *cf8;           /* [nsurf * 8 * 4]: the same for the 8 children of a leaf-parent */
+    uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
+    task_out *out;
+    build_stats st;
+    int failed;
+} worker;
+
+/* worker.c: allocate a worker's scratch for the context c (index 0 of its
+ * lists holds the full tapes); -1 when memory runs out. worker_free
+ * releases it, also after a failed worker_init. */
+int worker_init(worker *wk, const build_ctx *c);
+void worker_free(worker *wk);
+
+/* --- cell tests (cell_test.c) ------------------------------------------- */
+
+/* Tests the cell (depth, cell) for every surface that may cross its parent
+ * (lists at index pidx). Fills the cell's lists at index depth + 1 and, when
+ * it will be subdivided, its pruned tapes; box and centre receive the cell's
+ * box. Returns how many surfaces may cross it. */
+unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
+                             interval box[3], double centre[3]);
+
+/* The plain test of surface s (tape t) on one cell: 0 when the cell
+ * provably holds no point of it. */
+int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth, const interval box[3],
+                   const double centre[3]);
+
+/* The mean-value form centred on a voxel, with G the gradient enclosure of
+ * its parent and fd = f(centre) in double: 1 when it proves f != 0 over box. */
+int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
+                               const interval box[3], const double centre[3], double fd);
+
+/* The mean-value enclosures of the eight children of the node (depth, cell)
+ * with box pbox and centre pc, into out; G receives (or, with reuse_G,
+ * holds) the gradient enclosure over the node. 0 when unavailable. */
+int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
+                     unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
+                     interval out[8]);
+
+/* --- voxels (voxel_normal.c) -------------------------------------------- */
+
+/* A voxel's Newton iteration towards f = 0 (voxel_normal.c). */
+typedef struct newton {
+    double p[3], f, g[3]; /* the iterate and f, grad f there */
+    double fg[4];         /* f and grad f at the centre */
+    int step;
+} newton;
+
+typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
+
+/* f and its gradient at the voxel centre for surface s, into wk->cf.
+ * Normals, plane offsets and the surface choice use the whole function, not
+ * the cell's pruned tape: a term frozen into a constant kept f's value to a
+ * thousandth of a voxel but lost its gradient, which skews the normals and
+ * offsets (docs/perf-log.md, rasterize). */
+static inline const double *centre_fg(worker *wk, unsigned s, const double centre[3])
+{
+    double *fg = wk->cf + 4 * (size_t)s;
+    if (!wk->cf_ok[s]) {
+        fg[0] = tape_eval_grad(wk->c->full[s], centre, fg + 1, wk->dslots);
+        wk->st.point_evals++;
+        wk->cf_ok[s] = 1;
+    }
+    return fg;
+}
+
+/* The surface a voxel belongs to (lists at index idx): with several, the
+ * one nearest its centre by the first-order distance |f| / |grad f|. Starts
+ * its Newton iteration and forgets the centre values (wk->cf). */
+unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw);
+
+/* Appends the voxel's record (lists at index levels + 1). 0 when memory
+ * runs out (then wk->failed is set). */
+int emit_voxel(worker *wk, const interval box[3], const double centre[3]);
+
+/* The records of a leaf-parent's np voxels (children child[j], surfaces
+ * surf[j], iterations started in nw[j]), appended in child order: the
+ * Newton steps of all of them that still move are evaluated together, one
+ * pass over the tape per round (tape_eval_grad_lanes). */
+void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child, const uint8_t *surf,
+                 newton *nw, unsigned np);
+
+/* --- the recursion (subdivide.c) ---------------------------------------- */
+
+/* Builds the subtree of task cell `task` (Morton code at the task depth)
+ * into out. */
+void run_task(worker *wk, uint64_t task, task_out *out);
+
+#endif

@@ -1,0 +1,204 @@
+/* cell_test: whether a surface may cross a cell. The plain interval test
+ * (Duff 1992), the mean-value (first-order Taylor) form over a node's
+ * children and at the voxels, and the Lipschitz bound (Kalra & Barr 1989).
+ *
+ * Soundness. A cell is dropped only when an enclosure of f over it proves
+ * f != 0 everywhere in it, so no voxel holding a point of the surface is
+ * lost. The surface is the set of points of `bounds` where f is defined and
+ * equal to 0: a cell where f is defined nowhere (the NaN interval) holds no
+ * such point and is dropped; a cell where f may be undefined somewhere is
+ * judged by the enclosure of its defined part (interval.h) and counted in
+ * nan_cells. */
+#include <math.h>
+
+#include "rasterize/build_internal.h"
+#include "rasterize/cell_geometry.h"
+
+/* f over the degenerate box [c, c]: a sound enclosure of f(c). */
+static int eval_at_centre(worker *wk, const tape *t, const double centre[3], interval *fc)
+{
+    interval cb[3];
+    for (int k = 0; k < 3; k++)
+        cb[k].lo = cb[k].hi = centre[k];
+    unsigned fl = 0;
+    *fc = tape_eval_interval(t, cb, wk->slots2, &fl);
+    wk->st.interval_evals++;
+    return !fl && !interval_is_nan(*fc);
+}
+
+/* The mean-value form centred on the voxel itself, f([c]) + G . (box - c),
+ * with G the enclosure made for its parent: tighter than the node-centred
+ * form by the width of G times the offset of the centres, for one
+ * point-interval evaluation. Run on the voxels that form let through.
+ *
+ * fd is f(c) in double (the normal's first evaluation, made anyway). The
+ * point-interval evaluation, the costly part, runs only when fd lies within
+ * RETEST_MARGIN of the width of G . (box - c) from where the form could
+ * exclude 0. Elsewhere the form cannot succeed, f([c]) being within rounding
+ * (and the half-width of pruned constants, a thousandth of f's spread over a
+ * voxel) of fd, and the voxel is kept. Skipping a test only keeps a voxel, so
+ * soundness does not rest on the margin; it only makes the skip agree with
+ * the full test (docs/perf-log.md, rasterize). */
+#define RETEST_MARGIN 0.03125
+int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
+                               const interval box[3], const double centre[3], double fd)
+{
+    double wlo = 0.0, whi = 0.0; /* G . (box - c) in plain double: the margin covers rounding */
+    for (int k = 0; k < 3; k++) {
+        double rl = box[k].lo - centre[k], rh = box[k].hi - centre[k];
+        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
+        wlo += min2(min2(p1, p2), min2(p3, p4));
+        whi += max2(max2(p1, p2), max2(p3, p4));
+    }
+    double m = RETEST_MARGIN * (whi - wlo);
+    if (fd + m + wlo <= 0.0 && fd - m + whi >= 0.0) /* false on NaN or inf */
+        return 0;
+    interval fc;
+    if (!eval_at_centre(wk, t, centre, &fc))
+        return 0;
+    unsigned fl = 0;
+    interval sum = fc;
+    for (int k = 0; k < 3; k++) {
+        interval r = {interval_next_down(box[k].lo - centre[k]), interval_next_up(box[k].hi - centre[k])};
+        sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
+    }
+    return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
+}
+
+/* Kalra-Barr: |f(p) - f(c)| <= sum_k sup|df/dk| * r_k over the box. 1 when
+ * |f(c)| exceeds that bound. */
+static int lipschitz_excludes_zero(worker *wk, const tape *t, const interval box[3],
+                                   const double centre[3])
+{
+    interval g[3], fc;
+    unsigned fl = 0;
+    tape_eval_interval_grad(t, box, g, wk->islots, &fl);
+    wk->st.gradient_evals++;
+    if (fl || !eval_at_centre(wk, t, centre, &fc))
+        return 0;
+    double bound = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double gk = fmax(fabs(g[k].lo), fabs(g[k].hi));
+        double rk = fmax(centre[k] - box[k].lo, box[k].hi - centre[k]);
+        bound += gk * rk;
+    }
+    if (!isfinite(bound))
+        return 0;
+    bound = bound * (1.0 + 0x1p-40) + 0x1p-1000; /* cover the rounding of the sum */
+    return fc.lo > bound || fc.hi < -bound;
+}
+
+/* The plain test of one surface on one cell: 0 when the cell provably holds
+ * no point of it. Leaves the slot enclosures in wk->slots for pruning and
+ * sets *flags. */
+static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
+                             const interval box[3], const double centre[3], unsigned *flags)
+{
+    const build_ctx *c = wk->c;
+    *flags = 0;
+    interval v = tape_eval_interval(t, box, wk->slots, flags);
+    wk->st.interval_evals++;
+    wk->st.insns_evaluated += t->n;
+    wk->st.insns_full += c->full[s]->n;
+    if (interval_is_nan(v)) { /* defined nowhere in the cell: no surface point */
+        wk->st.nan_cells++;
+        return 0;
+    }
+    if (*flags) {
+        wk->st.nan_cells++;
+        return v.lo <= 0.0 && v.hi >= 0.0;
+    }
+    if (v.lo > 0.0 || v.hi < 0.0)
+        return 0;
+    if (c->par->method == BUILD_LIPSCHITZ && lipschitz_excludes_zero(wk, t, box, centre)) {
+        if (depth == c->levels)
+            wk->st.taylor_drops++;
+        return 0;
+    }
+    return 1;
+}
+
+int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
+                   const interval box[3], const double centre[3])
+{
+    unsigned flags;
+    return surface_may_cross(wk, t, s, depth, box, centre, &flags);
+}
+
+unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
+                             interval box[3], double centre[3])
+{
+    const build_ctx *c = wk->c;
+    if (!cell_box(c, depth, cell, box, centre))
+        return 0;
+    unsigned idx = depth + 1, n = 0, ns = c->nsurf;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k];
+        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+        unsigned flags;
+        if (!surface_may_cross(wk, t, s, depth, box, centre, &flags))
+            continue;
+        wk->act[(size_t)idx * ns + n++] = (uint8_t)s;
+        tape *child = &wk->tapes[(size_t)idx * ns + s];
+        if (depth < c->levels) {
+            /* Inherited by the whole subtree: decided min/max keep their
+             * winner, and terms that no longer vary over the cell (a far
+             * blob's exp(-50)) become constants. "No longer vary": narrower
+             * than a thousandth of f's spread over one voxel, estimated from
+             * its enclosure over this cell. */
+            interval v = wk->slots[t->root];
+            double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(c->levels - depth));
+            tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
+            tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
+            tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
+                             wk->scratch, child);
+        } else {
+            *child = *t;
+        }
+    }
+    wk->nact[idx] = n;
+    return n;
+}
+
+/* The mean-value enclosures of a node's eight children. With c the node's
+ * centre, fc an enclosure of f(c) and G one of the gradient over the node,
+ * every point p of child i satisfies f(p) in fc + sum_k G_k (p_k - c_k), and
+ * p_k - c_k lies in the lower or upper half-offset of axis k according to
+ * bit k of i. The six products are formed once, so a child costs three
+ * interval additions and no tape evaluation. The form's excess width shrinks
+ * with the square of the cell size, so on the finest levels it is tighter
+ * than the plain interval as well as cheaper. Returns 0 when G or f(c) may be
+ * undefined (then the caller tests the children one by one). */
+int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
+                     unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
+                     interval out[8])
+{
+    const build_ctx *c = wk->c;
+    interval fc, half[3][2];
+    unsigned fl = 0;
+    if (!reuse_G) {
+        tape_eval_interval_grad(t, pbox, G, wk->islots, &fl);
+        wk->st.gradient_evals++;
+    }
+    if (fl || !eval_at_centre(wk, t, pc, &fc))
+        return 0;
+    for (int k = 0; k < 3; k++) {
+        /* The children's shared face, rounded as cell_box rounds it. */
+        double m = c->origin[k] + (double)(2 * cell[k] + 1) * c->cell_edge[depth + 1];
+        interval lo = {interval_next_down(pbox[k].lo - pc[k]), interval_next_up(interval_next_up(m) - pc[k])};
+        interval hi = {interval_next_down(interval_next_down(m) - pc[k]), interval_next_up(pbox[k].hi - pc[k])};
+        half[k][0] = interval_mul(G[k], lo, &fl);
+        half[k][1] = interval_mul(G[k], hi, &fl);
+    }
+    /* fc + x-half, + y-half, + z-half, summed in that order for every
+     * child; children that share the first terms share their partial sums
+     * (2 + 4 + 8 additions instead of 3 x 8, the same values). */
+    interval s1[2], s2[4];
+    for (unsigned i = 0; i < 2; i++)
+        s1[i] = interval_add(fc, half[0][i], &fl);
+    for (unsigned i = 0; i < 4; i++)
+        s2[i] = interval_add(s1[i & 1], half[1][i >> 1], &fl);
+    for (unsigned i = 0; i < 8; i++)
+        out[i] = interval_add(s2[i & 3], half[2][i >> 2], &fl);
+    return !fl;
+}

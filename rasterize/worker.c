@@ -1,0 +1,44 @@
+/* worker: a build thread's scratch, sized once from the build context. */
+#include "rasterize/build_internal.h"
+
+int worker_init(worker *wk, const build_ctx *c)
+{
+    memset(wk, 0, sizeof *wk);
+    wk->c = c;
+    size_t depths = (size_t)c->levels + 2, len = c->max_len ? c->max_len : 1;
+    wk->slots = malloc(len * sizeof *wk->slots);
+    wk->slots2 = malloc(len * sizeof *wk->slots2);
+    wk->islots = malloc(len * sizeof *wk->islots);
+    wk->dslots = malloc(len * sizeof *wk->dslots);
+    wk->scratch = malloc(len * sizeof *wk->scratch);
+    wk->prune = malloc(depths * c->tape_total * sizeof *wk->prune);
+    wk->prune_konst = malloc(depths * c->konst_total * sizeof *wk->prune_konst);
+    wk->tapes = calloc(depths * c->nsurf, sizeof *wk->tapes);
+    wk->act = calloc(depths * c->nsurf, 1);
+    wk->nact = calloc(depths, sizeof *wk->nact);
+    wk->grad = calloc(depths * c->nsurf * 3, sizeof *wk->grad);
+    wk->grad_ok = calloc(depths * c->nsurf, 1);
+    wk->cf = malloc((size_t)c->nsurf * 4 * sizeof *wk->cf);
+    wk->cf_ok = calloc(c->nsurf, 1);
+    wk->cf8 = malloc((size_t)c->nsurf * 32 * sizeof *wk->cf8);
+    wk->lslots = malloc(len * sizeof *wk->lslots);
+    if (!wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
+        !wk->prune || !wk->prune_konst || !wk->tapes || !wk->act || !wk->nact || !wk->grad ||
+        !wk->grad_ok || !wk->cf || !wk->cf_ok || !wk->cf8)
+        return -1;
+    for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
+        wk->tapes[s] = *c->full[s];
+        wk->act[s] = (uint8_t)s;
+    }
+    wk->nact[0] = c->nsurf;
+    return 0;
+}
+
+void worker_free(worker *wk)
+{
+    free(wk->slots); free(wk->slots2); free(wk->islots); free(wk->dslots);
+    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act);
+    free(wk->nact);
+    free(wk->grad); free(wk->grad_ok);
+    free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->lslots);
+}

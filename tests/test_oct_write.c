@@ -1,0 +1,252 @@
+/* The .oct writer's contract (format/oct_write.c): usage errors, failing
+ * writes and allocation failures. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "format/oct.h"
+#include "format/oct_layout.h" /* oct__alloc_fail_after */
+#include "bench/oct_synth.h"
+
+static void test_writer_usage_errors(void **state)
+{
+    (void)state;
+    float pal[6] = {0.1f, 0.2f, 0.3f, 1, 1, 1};
+    oct_writer_params ok = {.levels = 2, .edge = 1.0, .surface_count = 2, .palette = pal};
+    oct_writer *w = (oct_writer *)1;
+    oct_writer_params p = ok;
+    p.levels = 0;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    assert_null(w);
+    p = ok; p.levels = 21;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.edge = 0;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.edge = NAN;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.origin[1] = INFINITY;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.surface_count = 0;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.surface_count = 256;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.root_cell[2] = 1; /* root_depth 0 has one cell */
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    p = ok; p.root_depth = 41;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+    float bad[6] = {0, 0, 0, 0, 2, 0};
+    p = ok; p.palette = bad;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_EUSAGE);
+
+    char *mem;
+    size_t memlen;
+    FILE *f = open_memstream(&mem, &memlen);
+    const uint8_t root = 0x81, zero = 0, two[2] = {1, 1};
+    uint32_t vox[3] = {1, 2, 3};
+    uint8_t surf_ok[3] = {0, 1, 1}, surf_bad[3] = {0, 2, 0};
+    /* Each case: a fresh writer, fed something inconsistent. */
+    assert_int_equal(oct_writer_create(&ok, &w), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 0, &zero, 1), OCT_EUSAGE);
+    assert_int_equal(oct_writer_add_masks(w, 2, &root, 1), OCT_EUSAGE); /* depth >= levels */
+    assert_int_equal(oct_writer_add_voxels(w, vox, surf_bad, 3), OCT_EUSAGE);
+    assert_int_equal(oct_writer_add_voxels(w, vox, NULL, 3), OCT_EUSAGE); /* 2 surfaces: needed */
+    uint32_t reserved = 0x80000000u;
+    assert_int_equal(oct_writer_add_voxels(w, &reserved, surf_ok, 1), OCT_EUSAGE);
+    assert_int_equal(oct_writer_add_masks(w, 0, &root, 1), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 1, two, 2), OCT_OK);
+    assert_int_equal(oct_writer_add_voxels(w, vox, surf_ok, 3), OCT_OK);
+    assert_int_equal(oct_writer_finish(w, f, NULL), OCT_EUSAGE); /* 2 voxels under the masks, 3 given */
+    assert_int_equal(oct_writer_add_voxels(w, vox, surf_ok, 1), OCT_EUSAGE); /* finished */
+    oct_writer_free(w);
+
+    assert_int_equal(oct_writer_create(&ok, &w), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 0, &root, 1), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 1, two, 1), OCT_OK); /* mask says 2 nodes */
+    assert_int_equal(oct_writer_add_voxels(w, vox, surf_ok, 1), OCT_OK);
+    assert_int_equal(oct_writer_finish(w, f, NULL), OCT_EUSAGE);
+    oct_writer_free(w);
+
+    assert_int_equal(oct_writer_create(&ok, &w), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 0, two, 2), OCT_OK); /* two roots */
+    assert_int_equal(oct_writer_finish(w, f, NULL), OCT_EUSAGE);
+    oct_writer_free(w);
+
+    assert_int_equal(oct_writer_create(&ok, &w), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 0, &root, 1), OCT_OK);
+    assert_int_equal(oct_writer_add_masks(w, 1, two, 2), OCT_OK);
+    assert_int_equal(oct_writer_add_voxels(w, vox, surf_ok, 2), OCT_OK);
+    assert_int_equal(oct_writer_finish(w, NULL, NULL), OCT_EUSAGE);
+    oct_writer_free(w);
+    oct_writer_free(NULL);
+    fclose(f);
+    free(mem);
+}
+
+/* A stream whose Nth write fails (fopencookie). Buffered with a small buffer,
+ * like a file: a failure surfaces inside some later fwrite, through its
+ * return value or the error flag. */
+typedef struct fail_stream { int calls, fail_at, sticky; size_t bytes; } fail_stream;
+static ssize_t fail_write(void *c, const char *b, size_t n)
+{
+    (void)b;
+    fail_stream *s = c;
+    s->calls++;
+    if (s->calls == s->fail_at || (s->sticky && s->calls > s->fail_at)) {
+        errno = ENOSPC;
+        return 0; /* not -1: glibc 2.36 adds a -1 from a cookie to the bytes left to write */
+    }
+    s->bytes += n;
+    return (ssize_t)n;
+}
+
+static void test_writer_write_failures(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 8, 60000, 2, 77, 0); /* > 32768 nodes at a depth: several node chunks */
+    unsigned char *good;
+    size_t good_len;
+    assert_int_equal(test_tree_write(&t, &good, &good_len), OCT_OK);
+    for (int sticky = 0; sticky <= 1; sticky++) {
+        for (int n = 1;; n++) {
+            fail_stream fs = {0, n, sticky, 0};
+            cookie_io_functions_t io = {.write = fail_write};
+            FILE *f = fopencookie(&fs, "w", io);
+            static char iobuf[4096];
+            setvbuf(f, iobuf, _IOFBF, sizeof iobuf);
+            oct_writer_params p = {.levels = t.levels, .edge = t.edge, .surface_count = 2, .palette = t.palette};
+            oct_writer *w;
+            assert_int_equal(oct_writer_create(&p, &w), OCT_OK);
+            for (uint32_t d = 0; d < t.levels; d++)
+                assert_int_equal(oct_writer_add_masks(w, d, t.masks[d], t.count[d]), OCT_OK);
+            assert_int_equal(oct_writer_add_voxels(w, t.voxels, t.surfaces, t.voxel_count), OCT_OK);
+            errno = 0;
+            uint64_t written = 1;
+            oct_err rc = oct_writer_finish(w, f, &written);
+            int e = errno;
+            oct_writer_free(w);
+            fclose(f);
+            if (rc == OCT_OK) {
+                assert_true(fs.calls < n); /* all writes done before the fault */
+                assert_int_equal(written, good_len);
+                break;
+            }
+            assert_int_equal(rc, OCT_EIO);
+            assert_int_equal(e, ENOSPC);
+            assert_int_equal(written, 0);
+            assert_true(n < 1000);
+        }
+    }
+    FILE *full = fopen("/dev/full", "wb");
+    if (full) { /* a full disk shows at the flush */
+        oct_writer_params p = {.levels = t.levels, .edge = t.edge, .surface_count = 1};
+        oct_writer *w;
+        assert_int_equal(oct_writer_create(&p, &w), OCT_OK);
+        assert_int_equal(oct_writer_finish(w, full, NULL), OCT_EIO); /* an empty tree */
+        oct_writer_free(w);
+        fclose(full);
+    }
+    free(good);
+    test_tree_free(&t);
+}
+
+/* Feeds t to a new writer in chunks; on ENOMEM retries the call once when
+ * `retry` (a single injected failure must leave the writer usable). */
+static oct_err feed_writer(const test_tree *t, int retry, unsigned char **out, size_t *out_len)
+{
+    oct_writer_params p = {.levels = t->levels, .edge = t->edge, .surface_count = t->surface_count,
+                           .palette = t->palette};
+    memcpy(p.origin, t->origin, sizeof p.origin);
+    oct_writer *w = NULL;
+    oct_err rc = oct_writer_create(&p, &w);
+    if (rc == OCT_ENOMEM && retry)
+        rc = oct_writer_create(&p, &w);
+    for (uint32_t d = 0; d < t->levels && rc == OCT_OK; d++) {
+        for (size_t i = 0; i < t->count[d] && rc == OCT_OK; i += 5000) {
+            size_t n = t->count[d] - i < 5000 ? t->count[d] - i : 5000;
+            rc = oct_writer_add_masks(w, d, t->masks[d] + i, n);
+            if (rc == OCT_ENOMEM && retry)
+                rc = oct_writer_add_masks(w, d, t->masks[d] + i, n);
+        }
+    }
+    for (size_t i = 0; i < t->voxel_count && rc == OCT_OK; i += 3000) {
+        size_t n = t->voxel_count - i < 3000 ? t->voxel_count - i : 3000;
+        rc = oct_writer_add_voxels(w, t->voxels + i, t->surfaces + i, n);
+        if (rc == OCT_ENOMEM && retry)
+            rc = oct_writer_add_voxels(w, t->voxels + i, t->surfaces + i, n);
+    }
+    char *mem = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&mem, &len);
+    if (rc == OCT_OK)
+        rc = oct_writer_finish(w, f, NULL);
+    oct_writer_free(w);
+    fclose(f);
+    *out = (unsigned char *)mem;
+    *out_len = len;
+    return rc;
+}
+
+static void test_allocation_failures(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 7, 30000, 3, 21, 0);
+    unsigned char *good;
+    size_t good_len;
+    assert_int_equal(feed_writer(&t, 0, &good, &good_len), OCT_OK);
+    for (int sticky = 0; sticky <= 1; sticky++) {
+        for (long n = 1;; n++) {
+            unsigned char *out;
+            size_t len;
+            oct__alloc_fail_after(n, sticky);
+            oct_err rc = feed_writer(&t, !sticky, &out, &len);
+            oct__alloc_fail_after(0, 0);
+            if (rc == OCT_OK) {
+                assert_int_equal(len, good_len);
+                assert_memory_equal(out, good, len);
+                free(out);
+                if (!sticky && n < 40)
+                    continue; /* the failure may land after the last allocation */
+                break;
+            }
+            free(out);
+            assert_int_equal(rc, OCT_ENOMEM);
+            assert_true(sticky);
+            assert_true(n < 1000);
+        }
+    }
+    /* The reader allocates its handle and, for a misaligned buffer, a copy. */
+    unsigned char *raw = malloc(good_len + 1);
+    memcpy(raw + 1, good, good_len);
+    for (long n = 1; n <= 3; n++) {
+        oct_file *f = (oct_file *)1;
+        oct__alloc_fail_after(n, 0);
+        oct_err rc = oct_open_memory(raw + 1, good_len, 0, &f, NULL);
+        oct__alloc_fail_after(0, 0);
+        assert_int_equal(rc, n < 3 ? OCT_ENOMEM : OCT_OK);
+        oct_close(f);
+    }
+    free(raw);
+    free(good);
+    test_tree_free(&t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_writer_usage_errors),
+        cmocka_unit_test(test_writer_write_failures),
+        cmocka_unit_test(test_allocation_failures),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
