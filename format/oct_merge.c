@@ -12,21 +12,6 @@
 #include <stdlib.h>
 #include <zlib.h>
 
-/* Format 1.1 header fields the merge reads (FORMAT.md §5). */
-enum {
-    MERGE_OFF_FUNCTION = 232, /* section entry of FUNCTION, after PALETTE */
-    MERGE_OFF_SHARD_COUNT = 256,
-    MERGE_OFF_SHARD_INDEX = 260,
-    MERGE_OFF_SHARD_DEPTH = 264,
-    MERGE_OFF_PARTITION_CRC = 268,
-    MERGE_OFF_MORTON_LO = 272,
-    MERGE_OFF_MORTON_HI = 280,
-    MERGE_OFF_SHARD_END = 288,
-    MERGE_HEADER_MIN = 320,   /* a 1.1 header: the shard fields exist */
-    MERGE_HEADER_MAX = 4096,  /* larger headers (a future minor) are refused */
-    MERGE_SECTIONS = OCT_SEC_COUNT + 1,
-    MERGE_SEC_FUNCTION = OCT_SEC_COUNT
-};
 #define MERGE_BUF (1u << 16)
 
 typedef struct part {
@@ -34,15 +19,15 @@ typedef struct part {
     uint32_t index;
     uint64_t lo, hi;
     uint64_t count[OCT_MAX_LEVELS], voxels;
-    uint64_t off[MERGE_SECTIONS], size[MERGE_SECTIONS];
-    uint32_t crc[MERGE_SECTIONS];
+    uint64_t off[OCT_SEC_COUNT], size[OCT_SEC_COUNT];
+    uint32_t crc[OCT_SEC_COUNT];
 } part;
 
 typedef struct merge {
     oct_merge_error *e;
     size_t n;
     part *parts;         /* in shard order once checked */
-    unsigned char head[MERGE_HEADER_MAX]; /* the first part's header: the template */
+    unsigned char head[OCT_HEADER_SIZE_1_1]; /* the first part's header: the template */
     uint32_t hsize, levels, count, depth, crc;
     uint8_t *cells;      /* 8^depth flags: a part holds that depth-k cell */
     unsigned char *buf;  /* MERGE_BUF bytes */
@@ -160,10 +145,10 @@ static oct_err same_as_first(merge *m, const part *p, const unsigned char *h, ui
         {OCT_OFF_LEVELS, OCT_OFF_SURFACE_COUNT, "a different grid (levels, origin or edge)"},
         {OCT_OFF_SURFACE_COUNT, OCT_OFF_VOXEL_COUNT, "a different scene (surface count)"},
         {OCT_SEC_OFF(OCT_SEC_PALETTE) + 8, OCT_SEC_OFF(OCT_SEC_PALETTE) + 24, "a different scene (palette)"},
-        {MERGE_OFF_FUNCTION + 8, MERGE_OFF_FUNCTION + 24, "a different scene (function)"},
-        {MERGE_OFF_SHARD_COUNT, MERGE_OFF_SHARD_INDEX, "a different partition (shard count)"},
-        {MERGE_OFF_SHARD_DEPTH, MERGE_OFF_MORTON_LO, "a different partition (depth or boundaries)"},
-        {MERGE_OFF_SHARD_END, MERGE_HEADER_MAX, "a different header"},
+        {OCT_SEC_OFF(OCT_SEC_FUNCTION) + 8, OCT_SEC_OFF(OCT_SEC_FUNCTION) + 24, "a different scene (function)"},
+        {OCT_OFF_SHARD_COUNT, OCT_OFF_SHARD_INDEX, "a different partition (shard count)"},
+        {OCT_OFF_SHARD_DEPTH, OCT_OFF_MORTON_LO, "a different partition (depth or boundaries)"},
+        {OCT_OFF_RESERVED2, OCT_HEADER_SIZE_1_1, "a different header"},
     };
     if (hsize != m->hsize)
         return fail(m, p->path, OCT_EUSAGE, "has a different header size from %s", m->parts[0].path);
@@ -194,7 +179,7 @@ static oct_err read_section(merge *m, const part *p, int k, unsigned char **out)
  * and CRCs are equal already: this leaves no doubt). */
 static oct_err same_scene_bytes(merge *m, const part *p)
 {
-    for (int k = OCT_SEC_PALETTE; k <= MERGE_SEC_FUNCTION; k++) {
+    for (int k = OCT_SEC_PALETTE; k <= OCT_SEC_FUNCTION; k++) {
         unsigned char *a = NULL, *b = NULL;
         oct_err r = read_section(m, &m->parts[0], k, &a);
         if (r == OCT_OK)
@@ -219,13 +204,16 @@ static oct_err read_header(merge *m, const part *p, unsigned char *h, uint32_t *
     if (r != OCT_OK)
         return r;
     *hsize = rd_u32le(h + OCT_OFF_HEADER_SIZE);
-    if (*hsize < MERGE_HEADER_MIN || rd_u16le(h + OCT_OFF_MINOR) < 1 ||
-        rd_u32le(h + MERGE_OFF_SHARD_COUNT) == 0)
+    uint16_t minor = rd_u16le(h + OCT_OFF_MINOR);
+    if (minor > 1) /* its new fields could matter: merging would drop them */
+        return fail(m, p->path, OCT_EUSAGE, "is format 1.%u, newer than this merge knows (1.1)",
+                    (unsigned)minor);
+    if (minor < 1 || *hsize != OCT_HEADER_SIZE_1_1)
         return fail(m, p->path, OCT_EUSAGE, "is not a shard (a whole file)");
-    if (*hsize > MERGE_HEADER_MAX)
-        return fail(m, p->path, OCT_EUSAGE, "has a %u-byte header, more than this merge knows",
-                    (unsigned)*hsize);
-    return read_range(m, p, OCT_HEADER_SIZE, *hsize - OCT_HEADER_SIZE, &crc, append_bytes, &at);
+    r = read_range(m, p, OCT_HEADER_SIZE, *hsize - OCT_HEADER_SIZE, &crc, append_bytes, &at);
+    if (r == OCT_OK && rd_u32le(h + OCT_OFF_SHARD_COUNT) == 0)
+        r = fail(m, p->path, OCT_EUSAGE, "is not a shard (a whole file)");
+    return r;
 }
 
 /* Pass 1 for part i: validate it, read its shard fields and sections,
@@ -243,13 +231,13 @@ static oct_err describe_part(merge *m, size_t i, const char *path)
     if (r != OCT_OK)
         return fail(m, path, r, "%s (byte %llu)", oct_strerror(r), (unsigned long long)where);
     const oct_tree *t = oct_get_tree(f);
-    unsigned char h[MERGE_HEADER_MAX];
+    unsigned char h[OCT_HEADER_SIZE_1_1];
     uint32_t hsize = 0;
     r = read_header(m, p, h, &hsize);
-    p->index = rd_u32le(h + MERGE_OFF_SHARD_INDEX);
-    p->lo = rd_u64le(h + MERGE_OFF_MORTON_LO);
-    p->hi = rd_u64le(h + MERGE_OFF_MORTON_HI);
-    uint32_t count = rd_u32le(h + MERGE_OFF_SHARD_COUNT), depth = rd_u32le(h + MERGE_OFF_SHARD_DEPTH);
+    p->index = rd_u32le(h + OCT_OFF_SHARD_INDEX);
+    p->lo = rd_u64le(h + OCT_OFF_MORTON_LO);
+    p->hi = rd_u64le(h + OCT_OFF_MORTON_HI);
+    uint32_t count = rd_u32le(h + OCT_OFF_SHARD_COUNT), depth = rd_u32le(h + OCT_OFF_SHARD_DEPTH);
     if (r == OCT_OK && (p->index >= count || depth > OCT_MERGE_MAX_DEPTH || depth >= t->levels ||
                         p->lo > p->hi || p->hi > (UINT64_C(1) << (3 * depth))))
         r = fail(m, path, OCT_EHEADER, "shard fields out of range (shard %u/%u, depth %u)",
@@ -260,18 +248,17 @@ static oct_err describe_part(merge *m, size_t i, const char *path)
         m->levels = t->levels;
         m->count = count;
         m->depth = depth;
-        m->crc = rd_u32le(h + MERGE_OFF_PARTITION_CRC);
+        m->crc = rd_u32le(h + OCT_OFF_PARTITION_CRC);
         m->cells = calloc((size_t)1 << (3 * depth), 1);
         if (!m->cells)
             r = fail(m, path, OCT_ENOMEM, "%s", oct_strerror(OCT_ENOMEM));
     } else if (r == OCT_OK) {
         r = same_as_first(m, p, h, hsize);
     }
-    for (int k = 0; k < MERGE_SECTIONS; k++) {
-        unsigned at = k < OCT_SEC_COUNT ? OCT_SEC_OFF(k) : MERGE_OFF_FUNCTION;
-        p->off[k] = rd_u64le(h + at);
-        p->size[k] = rd_u64le(h + at + 8);
-        p->crc[k] = rd_u32le(h + at + 16);
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        p->off[k] = rd_u64le(h + OCT_SEC_OFF(k));
+        p->size[k] = rd_u64le(h + OCT_SEC_OFF(k) + 8);
+        p->crc[k] = rd_u32le(h + OCT_SEC_OFF(k) + 16);
     }
     memcpy(p->count, t->node_count, sizeof p->count);
     p->voxels = t->voxel_count;
@@ -503,8 +490,8 @@ static oct_err rebuild_top(merge *m, uint8_t **top, uint64_t *top_count)
 /* Writes the sections after a zero header, then the header. */
 static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *top, const uint64_t *top_count)
 {
-    uint64_t count[OCT_MAX_LEVELS] = {0}, voxels = 0, size[MERGE_SECTIONS] = {0}, off[MERGE_SECTIONS] = {0};
-    uint32_t crc[MERGE_SECTIONS] = {0};
+    uint64_t count[OCT_MAX_LEVELS] = {0}, voxels = 0, size[OCT_SEC_COUNT] = {0}, off[OCT_SEC_COUNT] = {0};
+    uint32_t crc[OCT_SEC_COUNT] = {0};
     for (unsigned d = 0; d < m->levels; d++) {
         for (size_t i = 0; d >= m->depth && i < m->n; i++)
             count[d] += m->parts[i].count[d];
@@ -519,14 +506,19 @@ static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *t
         size[OCT_SEC_SURFACES] += m->parts[i].size[OCT_SEC_SURFACES];
     }
     size[OCT_SEC_PALETTE] = m->parts[0].size[OCT_SEC_PALETTE];
-    size[MERGE_SEC_FUNCTION] = m->parts[0].size[MERGE_SEC_FUNCTION];
+    size[OCT_SEC_FUNCTION] = m->parts[0].size[OCT_SEC_FUNCTION];
 
+    /* As the writer: 1.1 only when a flag or a function is there, else the
+     * 1.0 header of 256 bytes (the whole file is no shard). */
+    const int v11 = rd_u32le(m->head + OCT_OFF_FLAGS) != 0 || size[OCT_SEC_FUNCTION] != 0;
+    const uint32_t hsize = v11 ? OCT_HEADER_SIZE_1_1 : OCT_HEADER_SIZE;
+    const int nsec = v11 ? OCT_SEC_COUNT : OCT_SEC_COUNT_1_0;
     sink s = {m, f, 0, 0};
-    static const unsigned char zero[MERGE_HEADER_MAX];
-    if (put(&s, zero, m->hsize) != 0)
+    static const unsigned char zero[OCT_HEADER_SIZE_1_1];
+    if (put(&s, zero, hsize) != 0)
         return OCT_EIO;
     oct_err r = OCT_OK;
-    for (int k = 0; k < MERGE_SECTIONS && r == OCT_OK; k++) {
+    for (int k = 0; k < nsec && r == OCT_OK; k++) {
         if (!size[k])
             continue;
         off[k] = oct_align_up(s.bytes);
@@ -553,17 +545,21 @@ static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *t
         return r;
     *bytes = s.bytes;
 
-    unsigned char *h = m->head;
+    /* The parts' header up to the section table (identity, grid, surface
+     * count: equal in every part), then the whole's own fields. */
+    unsigned char h[OCT_HEADER_SIZE_1_1];
+    memset(h, 0, sizeof h);
+    memcpy(h, m->head, OCT_OFF_SECTIONS);
+    wr_u16le(h + OCT_OFF_MINOR, v11 ? 1 : 0);
+    wr_u32le(h + OCT_OFF_HEADER_SIZE, hsize);
     wr_u64le(h + OCT_OFF_VOXEL_COUNT, voxels);
-    for (int k = 0; k < MERGE_SECTIONS; k++) {
-        unsigned at = k < OCT_SEC_COUNT ? OCT_SEC_OFF(k) : MERGE_OFF_FUNCTION;
-        wr_u64le(h + at, off[k]);
-        wr_u64le(h + at + 8, size[k]);
-        wr_u32le(h + at + 16, crc[k]);
+    for (int k = 0; k < nsec; k++) {
+        wr_u64le(h + OCT_SEC_OFF(k), off[k]);
+        wr_u64le(h + OCT_SEC_OFF(k) + 8, size[k]);
+        wr_u32le(h + OCT_SEC_OFF(k) + 16, crc[k]);
     }
-    memset(h + MERGE_OFF_SHARD_COUNT, 0, MERGE_OFF_SHARD_END - MERGE_OFF_SHARD_COUNT);
-    wr_u32le(h + m->hsize - 4, (uint32_t)crc32_z(0, h, m->hsize - 4));
-    if (fseeko(f, 0, SEEK_SET) != 0 || fwrite(h, 1, m->hsize, f) != m->hsize || fflush(f) != 0 ||
+    wr_u32le(h + hsize - 4, (uint32_t)crc32_z(0, h, hsize - 4));
+    if (fseeko(f, 0, SEEK_SET) != 0 || fwrite(h, 1, hsize, f) != hsize || fflush(f) != 0 ||
         fseeko(f, 0, SEEK_END) != 0)
         return io_fail(m, NULL, "write");
     return OCT_OK;

@@ -233,6 +233,14 @@ static int rasterize_scene(const options *o)
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
     build_writer_params(sc, levels, palette, &wp);
+    if (bp.shard) { /* the shard's place in its partition, for --merge and --info */
+        wp.shard_count = shard.count;
+        wp.shard_index = shard.index;
+        wp.shard_depth = shard.depth;
+        wp.partition_crc = shard.crc;
+        wp.morton_lo = shard.lo;
+        wp.morton_hi = shard.hi;
+    }
     oct_err err = oct_writer_create(&wp, &w);
     if (err != OCT_OK) {
         diag_path_error(scene_path, "%s", oct_strerror(err));
