@@ -16,6 +16,7 @@ sh "$F/local-slurm.sh" start "$C" >"$OUT" 2>"$ERR" || fail "cannot start the loc
 eval "$(cat "$OUT")"
 [ "$SLURM_CONF" = "$C/slurm.conf" ] || fail "local-slurm.sh start printed: $(cat "$OUT")"
 RASTERIZE=$BIN/rasterize RENDER=$BIN/render; export RASTERIZE RENDER
+bound="timeout 60"   # a waited job that never ends fails (exit 124), never hangs the suite
 scene=$ROOT/scenes/sphere.scene
 no_parts() { [ -z "$(ls -A "$1" | grep parts)" ] || fail "parts left in $1: $(ls -A "$1")"; }
 same_dirs() {
@@ -25,7 +26,7 @@ same_dirs() {
 
 # A job array of 5 shards and the merge after it, waited for.
 "$BIN/rasterize" "$scene" -o "$T/whole.oct" --levels 7 -q || fail "whole rasterize"
-expect_exit 0 sh "$F/slurm-rasterize.sh" "$scene" "$T/s5.oct" --levels 7 --shards 5 --wait
+expect_exit 0 $bound sh "$F/slurm-rasterize.sh" "$scene" "$T/s5.oct" --levels 7 --shards 5 --wait
 cmp "$T/whole.oct" "$T/s5.oct" >&2 || fail "5 shards merged by Slurm differ from the whole run"
 no_parts "$T"
 
@@ -41,7 +42,7 @@ done
 expect_exit 0 sh "$F/slurm-rasterize.sh" "$scene" "$T/s3.oct" --levels 7 --shards 3
 merge=$(cat "$OUT")
 case $merge in '' | *[!0-9]*) fail "slurm-rasterize.sh printed '$merge', not a job id" ;; esac
-(cd "$T/b" && sh "$F/slurm-render.sh" "$T/s3.oct" --views "$T/v.views" --parts 3 --wait -q \
+(cd "$T/b" && $bound sh "$F/slurm-render.sh" "$T/s3.oct" --views "$T/v.views" --parts 3 --wait -q \
     -- --dependency="afterok:$merge") >"$OUT" 2>"$ERR" || fail "slurm-render.sh --wait"
 cmp "$T/whole.oct" "$T/s3.oct" >&2 || fail "3 shards merged by Slurm differ from the whole run"
 no_parts "$T"
@@ -51,7 +52,7 @@ same_dirs "$T/a" "$T/b" "a render array of 3 parts"
 # failed shard with its status and log; OUT.oct as it was, no parts left.
 printf 'bounds 0 0 0 1 1 1\nsurface x +\n' > "$T/bad.scene"
 cp "$T/whole.oct" "$T/keep.oct"
-expect_exit 1 sh "$F/slurm-rasterize.sh" "$T/bad.scene" "$T/keep.oct" --levels 7 --shards 2 --wait
+expect_exit 1 $bound sh "$F/slurm-rasterize.sh" "$T/bad.scene" "$T/keep.oct" --levels 7 --shards 2 --wait
 expect_err "task 0 of the job array failed (exit 1)"
 expect_err "task 0: $T/bad.scene:2:"
 expect_err "the merge did not run"
@@ -60,7 +61,7 @@ no_parts "$T"
 
 # A failing render task: --wait returns its status.
 mkdir "$T/c"
-(cd "$T/c" && sh "$F/slurm-render.sh" "$T/none.oct" --views "$T/v.views" --parts 2 --wait) \
+(cd "$T/c" && $bound sh "$F/slurm-render.sh" "$T/none.oct" --views "$T/v.views" --parts 2 --wait) \
     >"$OUT" 2>"$ERR" && fail "a render array of a missing file succeeded"
 expect_err "task 0 of the job array failed (exit 1)"
 
