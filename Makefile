@@ -71,8 +71,8 @@ endif
 #                                     tapes, intervals)
 #   common/view/     + common/        cameras and images
 #   rasterize/       + common/expr/ common/ format/
-#   render/          + common/view/ common/expr/ common/ format/  (the
-#                    expression engine for the stored tapes, format 1.1)
+#   render/          + common/view/ common/expr/ common/ format/  (the expression
+#                    engine evaluates the surface tapes a 1.1 file stores)
 #   bench/           + render/ common/expr/ common/view/ common/ format/
 #                    (measurement tools and their helpers, bench/README.md;
 #                    bench/tree_util builds synthetic trees for bench and tests)

@@ -231,7 +231,7 @@ static oct_err describe_part(merge *m, size_t i, const char *path)
     if (r != OCT_OK)
         return fail(m, path, r, "%s (byte %llu)", oct_strerror(r), (unsigned long long)where);
     const oct_tree *t = oct_get_tree(f);
-    unsigned char h[OCT_HEADER_SIZE_1_1];
+    unsigned char h[OCT_HEADER_SIZE_1_1] = {0};
     uint32_t hsize = 0;
     r = read_header(m, p, h, &hsize);
     p->index = rd_u32le(h + OCT_OFF_SHARD_INDEX);

@@ -15,7 +15,7 @@
 
 #include "format/oct.h"
 
-#define OCT_MERGE_MAX_DEPTH 8 /* deepest partition depth merged: 8^8 cell flags */
+#define OCT_MERGE_MAX_DEPTH 7 /* deepest partition depth merged: 8^7 cell flags (--shard uses <= 6) */
 
 typedef struct oct_merge_error {
     const char *path; /* the part at fault, or NULL for the output */

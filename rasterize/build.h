@@ -31,6 +31,7 @@ typedef struct build_params {
      * may be NULL. */
     void (*progress)(void *ctx, double fraction);
     void *progress_ctx;
+    int shell_only;      /* --shell-only: voxels without records (no normals, no Newton steps) */
     const build_shard *shard; /* NULL: the whole grid */
 } build_params;
 

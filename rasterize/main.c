@@ -15,6 +15,7 @@
 #include "common/test_hooks.h"
 #include "common/version.h"
 #include "common/expr/scene.h"
+#include "common/expr/tape_io.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
 #include "rasterize/merge.h"
@@ -24,12 +25,13 @@
 
 static const char usage_text[] =
     "usage: rasterize SCENE -o OUT.oct [--levels N] [--method interval|lipschitz]\n"
-    "                 [--threads N] [--shard I/N] [-q]\n"
+    "                 [--threads N] [--shell-only] [--shard I/N] [-q]\n"
     "       rasterize --merge -o OUT.oct PART.oct...\n";
 
 static const char help_text[] =
     "Subdivide space once around the implicit surfaces of SCENE and write the\n"
-    "voxels they pass through (normal, plane offset, surface) as a sparse octree.\n"
+    "voxels they pass through (normal, plane offset, surface) as a sparse octree,\n"
+    "with each surface's compiled function (for render --exact).\n"
     "\n"
     "  -o, --output OUT.oct   output file (written atomically: all or nothing)\n"
     "  --levels N             octree levels: a 2^N grid over the cube enclosing the\n"
@@ -40,6 +42,9 @@ static const char help_text[] =
     "                         |f(centre)| exceeds the gradient bound (Kalra-Barr)\n"
     "  --threads N            worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: the number of\n"
     "                         cores, at most " LIMIT_STR(THREADS_DEFAULT_MAX) ")\n"
+    "  --shell-only           store only the tree and the surface functions, no\n"
+    "                         per-voxel normals and planes (much smaller; the file\n"
+    "                         renders with render --exact only)\n"
     "  --shard I/N            write only shard I (0..N-1) of an N-way split of the\n"
     "                         grid (N <= " LIMIT_STR(SHARD_MAX_COUNT) "): a valid .oct of its part; the N\n"
     "                         shards merge into exactly the whole file\n"
@@ -105,7 +110,7 @@ typedef struct options {
     const char *scene_path, *out_path;
     long levels, threads;
     build_method method;
-    int quiet, sharded, merge;
+    int quiet, shell_only, sharded, merge;
     uint32_t shard_index, shard_count;
     const char **parts; /* the positional arguments: SCENE, or --merge's parts */
     size_t nparts;
@@ -138,6 +143,8 @@ static int parse_options(int argc, char **argv, options *o)
             return EXIT_OK;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             o->quiet = 1;
+        } else if (!strcmp(a, "--shell-only")) {
+            o->shell_only = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!has_value)
                 return diag_usage_error(usage_text, "option '%s' needs a file name", a);
@@ -207,6 +214,7 @@ static int rasterize_scene(const options *o)
     scene *sc = NULL;
     oct_writer *w = NULL;
     atomic_file *af = NULL;
+    unsigned char *function = NULL;
     double t0 = now_seconds();
     scene_error serr;
     if (scene_load(scene_path, &sc, &serr) != 0) {
@@ -220,7 +228,7 @@ static int rasterize_scene(const options *o)
     }
 
     progress pr = {!o->quiet && diag_stderr_is_tty(), -1};
-    build_params bp = {levels, o->method, (unsigned)o->threads, show_progress, &pr, NULL};
+    build_params bp = {levels, o->method, (unsigned)o->threads, show_progress, &pr, o->shell_only, NULL};
     build_shard shard;
     double share = 1.0;
     if (o->sharded) {
@@ -233,6 +241,17 @@ static int rasterize_scene(const options *o)
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
     build_writer_params(sc, levels, palette, &wp);
+    /* every file carries the surfaces' whole tapes (format 1.1), for --exact */
+    const tape *tapes[OCT_MAX_SURFACES];
+    for (size_t s = 0; s < sc->nsurfaces; s++)
+        tapes[s] = &sc->surfaces[s].tape;
+    int trc = tape_io_encode(tapes, (unsigned)sc->nsurfaces, &function, &wp.function_size);
+    if (trc != TAPE_OK) {
+        diag_path_error(scene_path, "%s", tape_strerror(trc));
+        goto done;
+    }
+    wp.function = function;
+    wp.flags = o->shell_only ? OCT_FLAG_SHELL_ONLY : 0;
     if (bp.shard) { /* the shard's place in its partition, for --merge and --info */
         wp.shard_count = shard.count;
         wp.shard_index = shard.index;
@@ -284,6 +303,7 @@ static int rasterize_scene(const options *o)
 done:
     atomic_file_abort(af);
     oct_writer_free(w);
+    free(function);
     scene_free(sc);
     return status;
 }

@@ -312,7 +312,7 @@ static int open_tree(const render_args *o, oct_file **file)
     if (err != OCT_OK) {
         if (err == OCT_EIO)
             diag_path_error(o->oct_path, "%s", strerror(errno));
-        else if (fault.offset)
+        else if (fault.offset) /* what: the broken rule, without "corrupt: " */
             diag_path_error(o->oct_path, "corrupt: %s at offset %llu", fault.what,
                             (unsigned long long)fault.offset);
         else

@@ -6,13 +6,19 @@
 . "$ROOT/tests/cli/lib.sh"
 : "${RELBIN:?RELBIN (the release programs) is set by tests/run.sh}"
 command -v groff >/dev/null || fail "groff is missing (tests/deps.sh installs it)"
+# The build that made RELBIN: build/rel, build/san, or build/rel-march-X
+# for `make ARCHFLAGS=-march=X`.
 case $RELBIN in
-    */san/bin) san=1 ;;
+    */san*/bin) san=1 ;;
     *) san=0 ;;
+esac
+arch=""
+case $RELBIN in
+    */build/*-march-*/bin) a=${RELBIN%/bin}; arch="ARCHFLAGS=-march=${a##*-march-}" ;;
 esac
 D="$T/dest"; P=/opt/dda
 # A make of its own: not the caller's job server or variables.
-mk() { env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s -C "$ROOT" SANITIZE=$san \
+mk() { env -u MAKEFLAGS -u MFLAGS -u MAKELEVEL make -s -C "$ROOT" SANITIZE=$san $arch \
            DESTDIR="$D" PREFIX=$P "$@" >"$OUT" 2>"$ERR"; }
 mk install || fail "make install"
 v=$(cat "$ROOT/VERSION")

@@ -21,6 +21,16 @@ cmp -s "$T/m.oct" "$T/whole.oct" || fail "merged file differs from the whole run
 expect_exit 0 "$BIN/rasterize" "$T/a1.oct" "$T/a0.oct" --merge "$T/a2.oct" -o "$T/m2.oct" -q
 cmp -s "$T/m2.oct" "$T/whole.oct" || fail "merged file (parts before --merge) differs"
 [ -s "$OUT" ] && fail "-q printed: $(cat "$OUT")"
+# --shell-only shards merge into the --shell-only whole run; mixed with full ones they are refused.
+expect_exit 0 "$BIN/rasterize" "$T/a.scene" -o "$T/shell.oct" --levels 7 -q --shell-only
+for i in 0 1 2; do
+    expect_exit 0 "$BIN/rasterize" "$T/a.scene" -o "$T/s$i.oct" --levels 7 -q --shard "$i/3" --shell-only
+done
+expect_exit 0 "$BIN/rasterize" --merge -o "$T/ms.oct" "$T/s1.oct" "$T/s2.oct" "$T/s0.oct" -q
+cmp -s "$T/ms.oct" "$T/shell.oct" || fail "merged shell-only file differs from the whole run"
+expect_exit 1 "$BIN/rasterize" --merge -o "$T/mix.oct" "$T/a0.oct" "$T/s1.oct" "$T/a2.oct"
+expect_err "rasterize: $T/s1.oct: has a different format version or flags from $T/a0.oct"
+[ -e "$T/mix.oct" ] && fail "a refused merge wrote its output"
 # render --info says which shard it is.
 expect_exit 0 "$BIN/render" --info "$T/a1.oct"
 grep -q "^shard: *1 of 3" "$OUT" || fail "--info on a shard: $(cat "$OUT")"
