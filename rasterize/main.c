@@ -17,6 +17,7 @@
 #include "common/expr/scene.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
+#include "rasterize/scene_limits.h"
 
 #define DEFAULT_LEVELS 10
 
@@ -167,9 +168,8 @@ int main(int argc, char **argv)
         scene_print_error(scene_path, &serr);
         goto done;
     }
-    if (sc->nsurfaces > OCT_MAX_SURFACES) {
-        diag_path_error(scene_path, "%zu surfaces; at most %d are supported", sc->nsurfaces,
-                        OCT_MAX_SURFACES);
+    if (scene_limits_check(sc, (unsigned)levels, &serr) != 0) {
+        scene_print_error(scene_path, &serr);
         goto done;
     }
 

@@ -303,7 +303,7 @@ static int open_tree(const render_args *o, oct_file **file)
         if (err == OCT_EIO)
             diag_path_error(o->oct_path, "%s", strerror(errno));
         else if (off)
-            diag_path_error(o->oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
+            diag_path_error(o->oct_path, "%s at offset %llu", oct_strerror(err), /* "corrupt: ..." */
                             (unsigned long long)off);
         else
             diag_path_error(o->oct_path, "%s", oct_strerror(err));
