@@ -37,8 +37,17 @@ changed "3:1:truncate -s 4096 $T/v.oct"   # during one: later pages gone, SIGBUS
 # and bases, indices far outside the mapping, SIGSEGV during a view.
 shifted="dd if=$T/s.oct bs=1 skip=3000 count=60000 2>/dev/null | dd of=$T/v.oct bs=1 seek=256 conv=notrunc 2>/dev/null"
 changed "3:0:$shifted"
-changed "3:1:$shifted"
-changed "3:2:cat $T/c.oct > $T/v.oct"     # rewritten in place, shorter
+changed "3:0:cat $T/c.oct > $T/v.oct"     # rewritten in place, shorter
+# During a view, the foreign indices make pointer arithmetic overflow, which
+# UBSan without recovery (make SANITIZE=1) stops at before any fault: these
+# run in the plain build only.
+case $BIN in
+*/build/san*) ;;
+*)
+    changed "3:1:$shifted"
+    changed "3:2:cat $T/c.oct > $T/v.oct"
+    ;;
+esac
 
 # Replaced by rename (as rasterize writes): the mapping keeps the old file.
 cp "$T/s.oct" "$T/v.oct"
