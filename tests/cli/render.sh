@@ -56,7 +56,7 @@ expect_exit 0 "$BIN/render" "$T/s.oct" --orbit 3 -o "$T/orbit/f_%02d.png" --size
 # A corrupt file is refused before any output, with where it is damaged.
 head -c 300 "$T/s.oct" > "$T/cut.oct"
 expect_exit 1 "$BIN/render" "$T/cut.oct" -o "$T/x.png"
-expect_err "render: $T/cut.oct: truncated file at offset "
+expect_err "render: $T/cut.oct: corrupt: "
 [ -e "$T/x.png" ] && fail "corrupt input left an output"
 expect_exit 1 "$BIN/render" "$T/missing.oct" -o "$T/x.png"
 expect_err "render: $T/missing.oct: No such file or directory"
