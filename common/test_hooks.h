@@ -5,6 +5,12 @@
  *                       sqrt(-1) ...) with SIGFPE, so a stray NaN stops the
  *                       run instead of reaching an output
  *     ATOMIC_FAULT=...  fail atomic_file's I/O on purpose (atomic_file.h)
+ *     DDA_RENDER_HOOK=VIEW:TILE:COMMAND
+ *                       render runs COMMAND (system(3)) once, when its view
+ *                       VIEW (from 1) has TILE tiles done (0: before the
+ *                       view's first ray), on the thread that called
+ *                       frame_render: with --threads 1 a fixed point of the
+ *                       run, to change the mapped file under it
  * Without the macro, the release programs never read those variables. */
 #ifndef TEST_HOOKS_H
 #define TEST_HOOKS_H
@@ -12,5 +18,10 @@
 /* Call first in main(); threads inherit the trap mask. A no-op in release
  * builds. */
 void test_hooks_init(void);
+
+/* DDA_RENDER_HOOK's points: the view about to be rendered (runs a TILE 0
+ * hook), then each count of tiles done. No-ops in release builds. */
+void test_hooks_view(unsigned view);
+void test_hooks_tile(unsigned long long done);
 
 #endif

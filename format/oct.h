@@ -64,6 +64,30 @@ typedef enum oct_err {
 /* Static English text for an error code; never NULL. */
 const char *oct_strerror(oct_err err);
 
+/* The cube rule (FORMAT.md §6), the usable range of both programs: a grid
+ * edge in [OCT_MIN_EDGE, OCT_MAX_COORD], |grid_origin| <= OCT_MAX_COORD on
+ * each axis, and the finest voxel no finer than 2^-OCT_RES_BITS of
+ * |grid_origin| + grid_edge, so that its corners are distinct doubles with
+ * bits to spare. Within it every squared distance the renderer forms stays a
+ * normal double. */
+#define OCT_MAX_COORD 1e30
+#define OCT_MIN_EDGE 1e-30
+#define OCT_RES_BITS 48
+
+typedef enum oct_cube_err {
+    OCT_CUBE_OK = 0,
+    OCT_CUBE_EDGE_LARGE,  /* grid_edge > OCT_MAX_COORD, infinite or NaN */
+    OCT_CUBE_EDGE_SMALL,  /* grid_edge < OCT_MIN_EDGE (zero and negative included) */
+    OCT_CUBE_ORIGIN_FAR,  /* |grid_origin| > OCT_MAX_COORD, infinite or NaN */
+    OCT_CUBE_VOXEL_FINE   /* |grid_origin| + grid_edge > 2^OCT_RES_BITS voxel edges */
+} oct_cube_err;
+
+/* Checks one axis of a grid whose finest voxels are 2^-(root_depth+levels)
+ * of its edge (levels + root_depth <= 60). The first rule broken, in the
+ * order of the enum. */
+oct_cube_err oct_cube_check(double grid_origin, double grid_edge, uint32_t root_depth,
+                            uint32_t levels);
+
 /* Eight nodes of one depth, exactly as stored (little-endian, 16 bytes). */
 typedef struct oct_group {
     uint64_t base;    /* next-depth index of the first child of node 8g */

@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "format/oct.h"
+
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
 #error "the .oct reader maps files in place and needs a little-endian host"
 #endif
@@ -19,8 +21,6 @@
 #define OCT_BOM_U32 0x01020304u
 #define OCT_BOM_F64 370.5      /* byte-order / float-format probe (exact in binary64) */
 #define OCT_MAX_ROOT_DEPTH 40u /* a subtree's root lies at most this deep in its grid */
-#define OCT_MAX_COORD 1e30     /* |grid_origin[i]| and grid_edge are at most this */
-#define OCT_MIN_VOXEL_RES 0x1p-48 /* finest voxel edge >= this x (|origin| + edge) */
 
 enum { /* header field offsets */
     OCT_OFF_MAGIC = 0,
@@ -85,15 +85,10 @@ static inline void wr_u32le(unsigned char *p, uint32_t v) { memcpy(p, &v, 4); }
 static inline void wr_u64le(unsigned char *p, uint64_t v) { memcpy(p, &v, 8); }
 static inline void wr_f64le(unsigned char *p, double v) { memcpy(p, &v, 8); }
 
-/* The cube rule (FORMAT.md, "Cube"): true when a grid with this corner
- * coordinate and edge, with its finest voxels 2^-(root_depth+levels) of the
- * edge, is representable: coordinates in range, voxel edge a normal double
- * and resolvable next to the largest coordinate. NaN fails. */
+/* The cube rule (FORMAT.md §6): oct_cube_check (oct.h) finds nothing wrong. */
 static inline int oct_cube_ok(double grid_origin, double grid_edge, uint32_t root_depth, uint32_t levels)
 {
-    double voxel = ldexp(grid_edge, -(int)(root_depth + levels));
-    return grid_edge > 0.0 && grid_edge <= OCT_MAX_COORD && voxel >= DBL_MIN &&
-           fabs(grid_origin) <= OCT_MAX_COORD && fabs(grid_origin) + grid_edge <= voxel / OCT_MIN_VOXEL_RES;
+    return oct_cube_check(grid_origin, grid_edge, root_depth, levels) == OCT_CUBE_OK;
 }
 
 /* Allocation inside format/ (oct_alloc.c). Tests arm a failure of the nth

@@ -19,6 +19,7 @@
 #include "format/oct.h"
 #include "rasterize/build.h"
 #include "rasterize/merge.h"
+#include "rasterize/scene_limits.h"
 #include "rasterize/shard.h"
 
 #define DEFAULT_LEVELS 10
@@ -221,9 +222,8 @@ static int rasterize_scene(const options *o)
         scene_print_error(scene_path, &serr);
         goto done;
     }
-    if (sc->nsurfaces > OCT_MAX_SURFACES) {
-        diag_path_error(scene_path, "%zu surfaces; at most %d are supported", sc->nsurfaces,
-                        OCT_MAX_SURFACES);
+    if (scene_limits_check(sc, (unsigned)levels, &serr) != 0) {
+        scene_print_error(scene_path, &serr);
         goto done;
     }
 

@@ -9,13 +9,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/test_hooks.h"
 #include "common/view/image.h"
+#include "render/map_guard.h"
 #include "render/beam.h"
 
 typedef struct frame_shared {
     const frame_job *job;
     uint32_t tiles_x, tiles_y;
     atomic_uint_fast64_t next, done, hits, steps;
+    atomic_int changed; /* set when map_guard abandoned a thread's work */
 } frame_shared;
 
 /* image_srgb8 without pow: the code value is the number of thresholds at or
@@ -203,6 +206,8 @@ static void work(frame_shared *sh, int caller)
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
     uint64_t hits = 0, steps = 0;
     for (;;) {
+        if (atomic_load_explicit(&sh->changed, memory_order_relaxed))
+            break; /* another thread met the file changing: stop */
         uint64_t t = atomic_fetch_add(&sh->next, 1);
         if (t >= total)
             break;
@@ -211,14 +216,36 @@ static void work(frame_shared *sh, int caller)
         uint64_t d = atomic_fetch_add(&sh->done, 1) + 1;
         if (caller && sh->job->progress)
             sh->job->progress(sh->job->progress_ctx, d, total);
+        if (caller)
+            test_hooks_tile(d);
     }
     atomic_fetch_add(&sh->hits, hits);
     atomic_fetch_add(&sh->steps, steps);
 }
 
+typedef struct work_arg {
+    frame_shared *sh;
+    int caller;
+} work_arg;
+
+static void work_fn(void *arg)
+{
+    const work_arg *w = arg;
+    work(w->sh, w->caller);
+}
+
+/* work under map_guard: a fault from the file changing ends this thread's
+ * share and marks the frame. */
+static void guarded_work(frame_shared *sh, int caller)
+{
+    work_arg w = {sh, caller};
+    if (map_guard_run(work_fn, &w) != 0)
+        atomic_store(&sh->changed, 1);
+}
+
 static void *worker(void *arg)
 {
-    work(arg, 0);
+    guarded_work(arg, 0);
     return NULL;
 }
 
@@ -233,6 +260,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
     atomic_init(&sh.done, 0);
     atomic_init(&sh.hits, 0);
     atomic_init(&sh.steps, 0);
+    atomic_init(&sh.changed, 0);
     unsigned extra = job->threads > 1 ? job->threads - 1 : 0;
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;
     int rc = 0;
@@ -244,12 +272,13 @@ int frame_render(const frame_job *job, frame_stats *stats)
         if (rc != 0)
             break;
     }
-    work(&sh, 1);
+    guarded_work(&sh, 1);
     for (unsigned k = 0; k < started; k++)
         pthread_join(tid[k], NULL);
     free(tid);
     stats->rays = (uint64_t)job->cam->width * job->cam->height;
     stats->hits = atomic_load(&sh.hits);
     stats->steps = atomic_load(&sh.steps);
+    stats->file_changed = atomic_load(&sh.changed);
     return rc;
 }

@@ -35,6 +35,7 @@ typedef struct frame_job {
 
 typedef struct frame_stats {
     uint64_t rays, hits, steps; /* steps: DDA steps, all rays */
+    int file_changed; /* the mapped file changed under a thread (map_guard.h): image incomplete */
 } frame_stats;
 
 /* Returns 0, or an errno value when a thread could not be started (the

@@ -18,6 +18,7 @@
 #include "common/version.h"
 #include "format/oct.h"
 #include "render/frame.h"
+#include "render/map_guard.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/views.h"
@@ -440,6 +441,10 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     double t0 = now_ms();
     frame_render(&job, &st);
     double ms = now_ms() - t0;
+    if (st.file_changed || map_guard_changed()) { /* before any output of this view */
+        diag_path_error(o->oct_path, "changed while being read");
+        return EXIT_RUNTIME;
+    }
     *total_ms += ms;
     *total_rays += st.rays;
     const char *op = NULL;
@@ -475,6 +480,11 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
     size_t first = o->part_count ? (size_t)o->part_index : 0, step = o->part_count ? (size_t)o->part_count : 1;
     size_t done = 0;
     for (size_t k = first; k < nviews; k += step, done++) {
+        test_hooks_view((unsigned)k + 1);
+        if (map_guard_changed()) {
+            diag_path_error(o->oct_path, "changed while being read");
+            return EXIT_RUNTIME;
+        }
         int st = render_view(tree, o, &list[k], &cams[k], buf, &total_ms, &total_rays);
         if (st != EXIT_OK)
             return st;
@@ -535,9 +545,18 @@ int main(int argc, char **argv)
         long n = sysconf(_SC_NPROCESSORS_ONLN);
         o.threads = n < 1 ? 1 : n > THREADS_DEFAULT_MAX ? THREADS_DEFAULT_MAX : n;
     }
+    if (map_guard_open(o.oct_path, oct_get_info(file)->file_size) != 0) {
+        if (errno)
+            diag_path_error(o.oct_path, "%s", strerror(errno));
+        else
+            diag_path_error(o.oct_path, "changed while being read");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
     status = render_views(tree, &o, list, nviews, cams, &buf);
 
 done:
+    map_guard_close();
     free(buf.rgb);
     free(buf.depth);
     free(buf.nrm);

@@ -46,6 +46,11 @@ interval interval_div(interval a, interval b, unsigned *flags)
         return nan_iv(flags);
     if (has_inf(a) && has_inf(b))
         *flags |= INTERVAL_MAYBE_NAN; /* inf/inf */
+    /* A divisor that is exactly 0 over the whole box: the quotient has no
+     * finite value anywhere (+-inf, or NaN for 0/0), so no point of the box
+     * can be on a surface through it: undefined everywhere (1/(x*0)). */
+    if (b.lo == 0.0 && b.hi == 0.0)
+        return nan_iv(flags);
     if (b.lo <= 0.0 && b.hi >= 0.0) {
         /* Either sign of infinity is reachable (a signed zero is not
          * visible to comparisons), so give up on half-infinite bounds. */
@@ -53,11 +58,12 @@ interval interval_div(interval a, interval b, unsigned *flags)
             *flags |= INTERVAL_MAYBE_NAN; /* 0/0 */
         return mk(-INFINITY, INFINITY);
     }
-    double q1 = a.lo / b.lo, q2 = a.lo / b.hi, q3 = a.hi / b.lo, q4 = a.hi / b.hi;
-    if (q1 != q1 || q2 != q2 || q3 != q3 || q4 != q4) { /* inf/inf */
+    /* inf/inf, tested before dividing (it would raise an invalid operation) */
+    if ((isinf(a.lo) || isinf(a.hi)) && (isinf(b.lo) || isinf(b.hi))) {
         *flags |= INTERVAL_MAYBE_NAN;
         return mk(-INFINITY, INFINITY);
     }
+    double q1 = a.lo / b.lo, q2 = a.lo / b.hi, q3 = a.hi / b.lo, q4 = a.hi / b.hi;
     return mk(dn(min2(min2(q1, q2), min2(q3, q4))), up(max2(max2(q1, q2), max2(q3, q4))));
 }
 

@@ -44,7 +44,8 @@ enum { INTERVAL_MAYBE_NAN = 1u };
 interval interval_around(double v);
 
 /* a / b, the quotient ends rounded one step outward. A divisor that touches
- * 0 gives [-inf, inf] (flagged when a touches 0 too: 0/0). */
+ * 0 gives [-inf, inf] (flagged when a touches 0 too: 0/0); one that is
+ * exactly [0, 0] gives the NaN interval (no finite quotient anywhere). */
 interval interval_div(interval a, interval b, unsigned *flags);
 /* sqrt(a), ends rounded one step outward, the lower end clamped at 0. The
  * negative part of a is flagged and dropped; all of a negative is NaN. */
@@ -172,8 +173,10 @@ INTERVAL_INLINE interval interval_add(interval a, interval b, unsigned *flags)
 {
     double flo = a.lo + b.lo, fhi = a.hi + b.hi;
     /* Fast path, same result: finite sums come from finite operands only
-     * (inf + x is inf or NaN), and then no flag can be raised. */
-    if (flo - flo == 0.0 && fhi - fhi == 0.0)
+     * (inf + x is inf or NaN), and then no flag can be raised. isfinite is a
+     * quiet test: no invalid-operation exception on inf or NaN (trap mode,
+     * README), where a relational test or inf - inf would raise one. */
+    if (isfinite(flo) && isfinite(fhi))
         return interval__mk(interval__sum_down(flo, a.lo, b.lo), interval__sum_up(fhi, a.hi, b.hi));
     if (interval__isnan(a) || interval__isnan(b))
         return interval__nan_flag(flags);
@@ -181,7 +184,7 @@ INTERVAL_INLINE interval interval_add(interval a, interval b, unsigned *flags)
      * -inf + inf may happen inside even when no corner shows it. */
     if ((a.lo == -INFINITY && b.hi == INFINITY) || (a.hi == INFINITY && b.lo == -INFINITY))
         *flags |= INTERVAL_MAYBE_NAN;
-    double lo = a.lo + b.lo, hi = a.hi + b.hi;
+    double lo = flo, hi = fhi;
     if (lo != lo) { /* -inf + inf: an operand is infinite at some point */
         lo = -INFINITY;
         *flags |= INTERVAL_MAYBE_NAN;
@@ -209,12 +212,12 @@ INTERVAL_INLINE interval interval_sub(interval a, interval b, unsigned *flags)
  * and the other corners. */
 static inline double interval__mul0(double x, double y, int *bad)
 {
-    double p = x * y;
-    if (p != p) {
+    /* tested before multiplying: 0 * inf would raise an invalid operation */
+    if ((x == 0.0 && isinf(y)) || (isinf(x) && y == 0.0)) {
         *bad = 1;
         return 0.0;
     }
-    return p;
+    return x * y;
 }
 
 /* a * b, ends rounded one step outward, except that a zero end coming from
@@ -247,7 +250,7 @@ INTERVAL_INLINE interval interval_mul(interval a, interval b, unsigned *flags)
         if (lo != 0.0 && hi != 0.0)
             return interval__mk(interval_next_down(lo), interval_next_up(hi));
     }
-    if ((a.lo - a.lo) + (a.hi - a.hi) + (b.lo - b.lo) + (b.hi - b.hi) == 0.0) {
+    if (isfinite(a.lo) && isfinite(a.hi) && isfinite(b.lo) && isfinite(b.hi)) { /* quiet tests */
         /* All ends finite, so no product is NaN and no flag is raised. The
          * same result as below, the underflow test made only when it counts. */
         double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;

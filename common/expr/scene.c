@@ -90,6 +90,10 @@ static void read_bounds(expr_parser *p, scene *sc, size_t start, int *have_bound
         sc->lo[a] = v[a];
         sc->hi[a] = v[a + 3];
     }
+    sc->bounds_line = p->line;
+    sc->bounds_col[0] = (unsigned)start + 1;
+    for (int i = 0; i < 6; i++)
+        sc->bounds_col[i + 1] = (unsigned)cols[i] + 1;
     *have_bounds = 1;
     *bounds_line = p->line;
 }
@@ -139,6 +143,7 @@ static void read_surface(expr_parser *p, scene *sc, size_t start, int *has_color
     }
     sf->color[0] = sf->color[1] = sf->color[2] = SCENE_DEFAULT_COLOR;
     sf->line = p->line;
+    sf->col = (unsigned)start + 1;
     sc->nsurfaces++;
     *has_color = 0;
 done:
@@ -301,17 +306,19 @@ int scene_load(const char *path, scene **out, scene_error *err)
     }
     for (;;) {
         if (len == cap) {
-            if (cap > SCENE_MAX_FILE) {
-                set_err(err, 1, 1, "file larger than %u bytes", SCENE_MAX_FILE);
+            if (len > SCENE_MAX_FILE) { /* reads stop one byte past the limit */
+                set_err(err, 1, 1, "file larger than %u bytes (%u MiB)", SCENE_MAX_FILE,
+                        SCENE_MAX_FILE >> 20);
                 goto done;
             }
-            char *t = realloc(text, cap * 2);
+            size_t nc = cap * 2 > (size_t)SCENE_MAX_FILE + 1 ? (size_t)SCENE_MAX_FILE + 1 : cap * 2;
+            char *t = realloc(text, nc);
             if (!t) {
                 set_err(err, 1, 1, "out of memory");
                 goto done;
             }
             text = t;
-            cap *= 2;
+            cap = nc;
         }
         ssize_t r = read(fd, text + len, cap - len);
         if (r < 0) {

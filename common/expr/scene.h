@@ -23,10 +23,13 @@ typedef struct scene_surface {
     tape tape;       /* f; the surface is f = 0. Owned by the scene. */
     double color[3]; /* R G B in 0..1 */
     unsigned line;   /* line of its `surface` statement */
+    unsigned col;    /* column of its `surface` keyword */
 } scene_surface;
 
 typedef struct scene {
     double lo[3], hi[3]; /* bounds: lo < hi on each axis, both finite */
+    unsigned bounds_line;    /* where `bounds` is, for errors about its values */
+    unsigned bounds_col[7];  /* columns of the keyword, then of X0 Y0 Z0 X1 Y1 Z1 */
     size_t nsurfaces;    /* >= 1 */
     scene_surface *surfaces;
 } scene;

@@ -314,6 +314,15 @@ int32_t tape_emit_binary(tape_builder *b, tape_op op, int32_t a, int32_t c)
         return c;
     if (is_const(b, a) && is_const(b, c))
         return fold(b, op, a, c, 0.0);
+    if (op == TAPE_SUB && a == c) {
+        /* a - a is 0 wherever a is finite (NaN where it is not), and so is
+         * a * 0; but over a box a - a encloses to [-w, w] and a * 0 to [0, 0],
+         * so that 1/(x-x) is nowhere a surface instead of a grid of poles. */
+        c = tape_emit_const(b, 0.0, 0.0, 0.0);
+        if (c < 0)
+            return c;
+        op = TAPE_MUL;
+    }
     if ((op == TAPE_ADD || op == TAPE_MUL || op == TAPE_MIN || op == TAPE_MAX) && c < a) {
         int32_t t = a;
         a = c;

@@ -42,7 +42,7 @@ interval tape_eval_interval(const tape *t, const interval box[3], interval *s, u
 }
 
 static int is_zero(interval a) { return a.lo == 0.0 && a.hi == 0.0; }
-static int is_finite(interval a) { return (a.lo - a.lo) + (a.hi - a.hi) == 0.0; }
+static int is_finite(interval a) { return isfinite(a.lo) && isfinite(a.hi); } /* quiet: no trap */
 
 /* interval_mul for the partials: those of a term without that variable are
  * [0, 0], and [0, 0] times a finite interval is [+0, +0] in interval_mul
