@@ -228,7 +228,12 @@ static int rasterize_scene(const options *o)
     }
 
     progress pr = {!o->quiet && diag_stderr_is_tty(), -1};
-    build_params bp = {levels, o->method, (unsigned)o->threads, show_progress, &pr, o->shell_only, NULL};
+    build_params bp = {.levels = levels,
+                       .method = o->method,
+                       .threads = (unsigned)o->threads,
+                       .progress = show_progress,
+                       .progress_ctx = &pr,
+                       .shell_only = o->shell_only};
     build_shard shard;
     double share = 1.0;
     if (o->sharded) {

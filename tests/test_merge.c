@@ -64,7 +64,7 @@ static void rasterize_to(const scene *sc, unsigned levels, unsigned threads, uin
                          TAPE_OK);
         wp.function = function;
     }
-    build_params bp = {levels, BUILD_INTERVAL, threads, NULL, NULL, 0, NULL};
+    build_params bp = {.levels = levels, .method = BUILD_INTERVAL, .threads = threads};
     build_shard sh;
     if (count) {
         assert_int_equal(shard_plan(sc, &bp, index, count, &sh, NULL), 0);

@@ -136,7 +136,7 @@ static void build_part(const scene *sc, unsigned levels, unsigned threads, uint3
     build_writer_params(sc, levels, palette, &wp);
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {levels, BUILD_INTERVAL, threads, NULL, NULL, 0, NULL};
+    build_params bp = {.levels = levels, .method = BUILD_INTERVAL, .threads = threads};
     if (count) {
         double share = -1.0;
         assert_int_equal(shard_plan(sc, &bp, index, count, sh, &share), 0);
