@@ -223,13 +223,17 @@ static oct_err describe_part(merge *m, size_t i, const char *path)
     part *p = &m->parts[i];
     p->path = path;
     oct_file *f = NULL;
-    uint64_t where = 0;
+    oct_fault fault = {0, NULL};
     errno = 0;
-    oct_err r = oct_open(path, 0, &f, &where);
+    oct_err r = oct_open_fault(path, 0, &f, &fault);
     if (r == OCT_EIO)
         return io_fail(m, path, "open");
+    if (r == OCT_EFUNCTION) /* the broken rule of the FUNCTION section, as render says it */
+        return fail(m, path, r, "corrupt: %s at offset %llu", fault.what, (unsigned long long)fault.offset);
+    if (r != OCT_OK && fault.offset)
+        return fail(m, path, r, "%s at offset %llu", oct_strerror(r), (unsigned long long)fault.offset);
     if (r != OCT_OK)
-        return fail(m, path, r, "%s (byte %llu)", oct_strerror(r), (unsigned long long)where);
+        return fail(m, path, r, "%s", oct_strerror(r));
     const oct_tree *t = oct_get_tree(f);
     unsigned char h[OCT_HEADER_SIZE_1_1] = {0};
     uint32_t hsize = 0;
