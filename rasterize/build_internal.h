@@ -73,6 +73,17 @@ typedef struct task_out {
     int done;
 } task_out;
 
+/* 1 when t has an abs, min or max: a kink, where the gradient enclosure
+ * spans both branches and the mean-value form is loose, so the plain
+ * interval test may still drop a voxel the form keeps. */
+static inline uint8_t tape_has_kink(const tape *t)
+{
+    for (uint32_t i = 0; i < t->n; i++)
+        if (t->insn[i].op == TAPE_ABS || t->insn[i].op == TAPE_MIN || t->insn[i].op == TAPE_MAX)
+            return 1;
+    return 0;
+}
+
 /* --- per-thread state --------------------------------------------------- */
 
 typedef struct worker {
@@ -86,6 +97,7 @@ typedef struct worker {
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
     tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
     uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
+    uint8_t *kinked;       /* [(levels + 2) * nsurf]: the cell's tape of that surface has a kink */
     unsigned *nact;        /* [levels + 2] */
     interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
     double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */

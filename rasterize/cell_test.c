@@ -152,8 +152,10 @@ unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const ui
             tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
             tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
                              wk->scratch, child);
+            wk->kinked[(size_t)idx * ns + s] = tape_has_kink(child);
         } else {
             *child = *t;
+            wk->kinked[(size_t)idx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
         }
     }
     wk->nact[idx] = n;

@@ -51,6 +51,34 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
     }
 }
 
+/* Whether the tests a child of the node (depth) faces after the node's
+ * mean-value form (ok: that form was available for surface s) drop it.
+ * Without the form, or on coarse cells, the plain interval test. At the
+ * voxels, the form centred on the voxel, then on a tape with a kink the
+ * plain interval test too: there the gradient enclosure spans both branches
+ * and the forms are loose where the interval is not (csg, gyroid). */
+static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const interval box[3],
+                         const double centre[3])
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1;
+    const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+    if (!ok || depth + 1 < MEAN_VALUE_ALONE_DEPTH) {
+        if (cell_may_cross(wk, t, s, depth + 1, box, centre))
+            return 0;
+        wk->st.taylor_drops += (unsigned)ok;
+        return 1;
+    }
+    if (depth + 1 < c->levels)
+        return 0;
+    if (centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], box, centre,
+                                   centre_fg(wk, s, centre)[0])) {
+        wk->st.taylor_drops++;
+        return 1;
+    }
+    return wk->kinked[(size_t)pidx * ns + s] && !cell_may_cross(wk, t, s, depth + 1, box, centre);
+}
+
 /* The finest levels: children are tested with child_enclosures, inheriting
  * the node's tapes (pruning no longer pays this deep); voxels are emitted,
  * deeper nodes recursed into. Where the mean-value form is not available for
@@ -101,17 +129,13 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                 memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
                 wk->cf_ok[s] = 1;
             }
-            if (!ok[k] || depth + 1 < MEAN_VALUE_ALONE_DEPTH
-                    ? !cell_may_cross(wk, t, s, depth + 1, box, centre)
-                    : depth + 1 == c->levels &&
-                          centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3],
-                                                     box, centre, centre_fg(wk, s, centre)[0])) {
-                wk->st.taylor_drops += ok[k];
+            if (child_dropped(wk, depth, s, ok[k], box, centre)) {
                 wk->cf_ok[s] = 0;
                 continue;
             }
             wk->act[(size_t)cidx * ns + n++] = (uint8_t)s;
             wk->tapes[(size_t)cidx * ns + s] = *t;
+            wk->kinked[(size_t)cidx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
         }
         wk->nact[cidx] = n;
         if (!n)
