@@ -53,15 +53,17 @@ if [ -f "$RES/rastspeed.csv" ] && [ "$(wc -l <"$RES/rastspeed.csv")" -gt 1 ]; th
     echo
     echo "Rasterize speed, one run each: M voxels kept a second (wall time with start-up) and CPU use"
     echo "(user + system over wall: 200 % keeps both cores busy); the shell: voxels kept over the voxels"
-    echo "the surface really passes through (\`bench/shellratio\`: a sign change on a 5³ lattice per voxel):"
+    echo "the surface really passes through (\`bench/shellratio\`: a sign change on a 5³ lattice per voxel),"
+    echo "and the stored records against the exact surface (\`bench/normalerr\`: normal against the gradient"
+    echo "at the foot point of the voxel centre, plane offset against the distance to it):"
     echo
     echo "| scene | levels | seconds | voxels | M voxels/s | CPU % |"
     echo "|---|---|---|---|---|---|"
     awk -F, 'NR > 1 { printf "| %s | %d | %.2f | %d | %.2f | %s |\n", $6, $7, $8, $9, $10, $11 }' "$RES/rastspeed.csv"
     echo
-    echo "| scene | levels | kept | real | kept / real | real ones lost |"
-    echo "|---|---|---|---|---|---|"
-    awk -F, 'NR > 1 { printf "| %s | %d | %d | %d | %.3f | %d |\n", $6, $7, $8, $9, $10, $11 }' "$RES/shell.csv"
+    echo "| scene | levels | kept | real | kept / real | real ones lost | normal err mean / p99 ° | offset err mean / p99 voxel |"
+    echo "|---|---|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { printf "| %s | %d | %d | %d | %.3f | %d | %.3f / %.3f | %.4f / %.4f |\n", $6, $7, $8, $9, $10, $11, $14, $15, $17, $18 }' "$RES/shell.csv"
 fi
 if [ "$(wc -l <"$RES/povray.csv")" -gt 1 ]; then
     echo

@@ -31,7 +31,7 @@ full)
 esac
 D=$(dirname "$0")
 for t in "$BIN/rasterize" "$BIN/render" "$TOOLS/refcast" "$TOOLS/imgcompare" "$TOOLS/gradmax" \
-         "$TOOLS/scene2pov" "$TOOLS/shellratio"; do
+         "$TOOLS/scene2pov" "$TOOLS/shellratio" "$TOOLS/normalerr"; do
     [ -x "$t" ] || { echo "bench: $t missing: run 'make all tools' first" >&2; exit 1; }
 done
 sh "$D/deps.sh" "$MODE"
@@ -159,7 +159,7 @@ done
 # kept over the voxels the surface really passes through (bench/shellratio) ----
 SPEED="$RES/rastspeed.csv" SHELL="$RES/shell.csv"
 echo "$PROVH,scene,levels,seconds,voxels,mvox_s,cpu_pct" >"$SPEED"
-echo "$PROVH,scene,levels,kept,real,ratio,lost" >"$SHELL"
+echo "$PROVH,scene,levels,kept,real,ratio,lost,voxels_near,voxels_missed,normal_mean_deg,normal_p99_deg,normal_max_deg,offset_mean_vox,offset_p99_vox,offset_max_vox" >"$SHELL"
 for s in $SPEED_SCENES; do
     for L in $SPEED_LEVELS; do
         o="$WORK/speed.oct"
@@ -182,9 +182,10 @@ for s in $SPEED_SCENES; do
         o="$WORK/shell.oct"
         "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" -q
         r=$("$TOOLS/shellratio" "scenes/$s.scene" "$o" --csv) || echo "bench: $s levels $L: shellratio failed" >&2
+        ne=$("$TOOLS/normalerr" "scenes/$s.scene" "$o" --csv)
         rm -f "$o"
-        echo "$PROV,$s,$L,$r" >>"$SHELL"
-        echo "  shell $s levels $L: kept,real,ratio,lost = $r"
+        echo "$PROV,$s,$L,$r,$ne" >>"$SHELL"
+        echo "  shell $s levels $L: kept,real,ratio,lost = $r; records against the exact surface: $ne"
     done
 done
 
