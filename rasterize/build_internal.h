@@ -103,6 +103,8 @@ typedef struct worker {
     double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */
     uint8_t *cf_ok;        /* [nsurf]: cf holds them for that surface (voxel_surface clears) */
     double *cf8;           /* [nsurf * 8 * 4]: the same for the 8 children of a leaf-parent */
+    uint8_t *cf8_have;     /* [nsurf]: the children whose cf8 entries are set, 0 on a tape with
+                              a kink (their differences do not estimate second derivatives) */
     uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
     task_out *out;
     build_stats st;
@@ -178,9 +180,11 @@ unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton 
 int emit_voxel(worker *wk, const interval box[3], const double centre[3]);
 
 /* The records of a leaf-parent's np voxels (children child[j], surfaces
- * surf[j], iterations started in nw[j]), appended in child order: the
- * Newton steps of all of them that still move are evaluated together, one
- * pass over the tape per round (tape_eval_grad_lanes). */
+ * surf[j], iterations started in nw[j]), appended in child order. Where the
+ * siblings' centre gradients (wk->cf8) give a Hessian, one Newton step on the
+ * second-order model about the centre; elsewhere the Newton steps of all of
+ * them that still move are evaluated together, one pass over the tape per
+ * round (tape_eval_grad_lanes). */
 void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child, const uint8_t *surf,
                  newton *nw, unsigned np);
 

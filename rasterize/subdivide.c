@@ -25,9 +25,10 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
     for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
+        wk->cf8_have[s] = 0;
         if (!ok[k])
             continue;
-        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
         double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
         for (unsigned i = 0; i < 8; i++) {
             if (T[k][i].lo > 0.0 || T[k][i].hi < 0.0 || !child_box(cb, i))
@@ -47,7 +48,10 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
             fg[1] = g[0][l];
             fg[2] = g[1][l];
             fg[3] = g[2][l];
+            wk->cf8_have[s] |= (uint8_t)(1u << lane[l]);
         }
+        if (wk->kinked[(size_t)pidx * ns + s])
+            wk->cf8_have[s] = 0;
     }
 }
 

@@ -22,10 +22,11 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->cf = malloc((size_t)c->nsurf * 4 * sizeof *wk->cf);
     wk->cf_ok = calloc(c->nsurf, 1);
     wk->cf8 = malloc((size_t)c->nsurf * 32 * sizeof *wk->cf8);
+    wk->cf8_have = calloc(c->nsurf, 1);
     wk->lslots = malloc(len * sizeof *wk->lslots);
     if (!wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
         !wk->prune || !wk->prune_konst || !wk->tapes || !wk->act || !wk->kinked || !wk->nact || !wk->grad ||
-        !wk->grad_ok || !wk->cf || !wk->cf_ok || !wk->cf8)
+        !wk->grad_ok || !wk->cf || !wk->cf_ok || !wk->cf8 || !wk->cf8_have)
         return -1;
     for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
         wk->tapes[s] = *c->full[s];
@@ -42,5 +43,5 @@ void worker_free(worker *wk)
     free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act); free(wk->kinked);
     free(wk->nact);
     free(wk->grad); free(wk->grad_ok);
-    free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->lslots);
+    free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->cf8_have); free(wk->lslots);
 }
