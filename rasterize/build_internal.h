@@ -106,6 +106,8 @@ typedef struct worker {
     uint8_t *cf8_have;     /* [nsurf]: the children whose cf8 entries are set, 0 on a tape with
                               a kink (their differences do not estimate second derivatives) */
     uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
+    interval *fcen;        /* [(levels + 2) * nsurf]: with it, f's enclosure at the form's centre */
+    double (*ncen)[3];     /* [levels + 2]: the node's centre, the form's */
     task_out *out;
     build_stats st;
     int failed;
@@ -137,11 +139,13 @@ int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
                                const interval box[3], const double centre[3], double fd);
 
 /* The mean-value enclosures of the eight children of the node (depth, cell)
- * with box pbox and centre pc, into out; G receives (or, with reuse_G,
- * holds) the gradient enclosure over the node. 0 when unavailable. */
-int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
-                     unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
-                     interval out[8]);
+ * with box pbox, into out, the form centred on fcc. Without reuse, G and fc
+ * receive the gradient enclosure over the node and f's enclosure at fcc, the
+ * node's centre; with reuse they hold those of a box holding the node (its
+ * parent's), centred on fcc. 0 when unavailable. */
+int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned depth,
+                     const uint64_t cell[3], const double fcc[3], interval *fc, interval G[3],
+                     int reuse, interval out[8]);
 
 /* --- voxels (voxel_normal.c) -------------------------------------------- */
 

@@ -95,17 +95,21 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     double pc[3];
     uint8_t ok[OCT_MAX_SURFACES], mask = 0;
     cell_box(c, depth, cell, pbox, pc);
+    memcpy(wk->ncen[pidx], pc, sizeof pc);
     /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
      * holds its own, one evaluation fewer for a slightly wider form. */
     int reuse = depth + 1 == c->levels; /* its parent ran here too: MEAN_VALUE_LEVELS >= 2 */
     for (unsigned k = 0; k < wk->nact[pidx]; k++) {
         unsigned s = wk->act[(size_t)pidx * ns + k];
         interval *G = &wk->grad[((size_t)pidx * ns + s) * 3];
-        if (reuse && wk->grad_ok[(size_t)depth * ns + s])
+        interval *fc = &wk->fcen[(size_t)pidx * ns + s];
+        int r = reuse && wk->grad_ok[(size_t)depth * ns + s];
+        if (r) {
             memcpy(G, &wk->grad[((size_t)depth * ns + s) * 3], 3 * sizeof *G);
-        ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, pc, depth,
-                                          cell, G, reuse && wk->grad_ok[(size_t)depth * ns + s],
-                                          T[k]);
+            *fc = wk->fcen[(size_t)depth * ns + s];
+        }
+        ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, depth, cell,
+                                          r ? wk->ncen[depth] : pc, fc, G, r, T[k]);
         wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
     child_boxes cb; /* most children fall to T alone: boxes are made lazily */
