@@ -174,7 +174,7 @@ int main(int argc, char **argv)
     }
 
     progress pr = {!quiet && diag_stderr_is_tty(), -1};
-    build_params bp = {(unsigned)levels, method, (unsigned)threads, show_progress, &pr};
+    build_params bp = {(unsigned)levels, method, (unsigned)threads, show_progress, &pr, 0};
     build_stats st;
     err = build_octree(sc, &bp, w, &st);
     if (err != OCT_OK) {

@@ -103,6 +103,10 @@ unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton 
 {
     const unsigned ns = wk->c->nsurf;
     unsigned best = wk->act[(size_t)idx * ns];
+    if (wk->c->par->shell_only && wk->nact[idx] == 1) { /* no record: nothing to evaluate */
+        wk->cf_ok[best] = 0;
+        return best;
+    }
     if (wk->nact[idx] > 1) {
         double best_dist = INFINITY;
         for (unsigned k = 0; k < wk->nact[idx]; k++) {
@@ -142,6 +146,8 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
     unsigned idx = c->levels + 1;
     newton nw;
     unsigned best = voxel_surface(wk, idx, centre, &nw);
+    if (c->par->shell_only)
+        return push_voxel(wk, 0, best);
     const tape *t = c->full[best];
     double h = c->cell_edge[c->levels];
     while (newton_advance(&nw, box, h)) {
@@ -211,6 +217,11 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
                  const uint8_t *surf, newton *nw, unsigned np)
 {
     const build_ctx *c = wk->c;
+    if (c->par->shell_only) {
+        for (unsigned j = 0; j < np && !wk->failed; j++)
+            push_voxel(wk, 0, surf[j]);
+        return;
+    }
     double h = c->cell_edge[c->levels];
     uint8_t live[8];
     double H[3][3];

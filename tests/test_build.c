@@ -33,17 +33,15 @@ typedef struct built {
     build_stats st;
 } built;
 
-static void build_in_memory(const scene *sc, unsigned levels, build_method method, unsigned threads,
-                            built *b)
+static void build_with(const scene *sc, const build_params *bp, built *b)
 {
     memset(b, 0, sizeof *b);
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
-    build_writer_params(sc, levels, palette, &wp);
+    build_writer_params(sc, bp->levels, palette, &wp);
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {levels, method, threads, NULL, NULL};
-    assert_int_equal(build_octree(sc, &bp, w, &b->st), OCT_OK);
+    assert_int_equal(build_octree(sc, bp, w, &b->st), OCT_OK);
     FILE *mem = open_memstream(&b->bytes, &b->size);
     assert_non_null(mem);
     uint64_t n = 0;
@@ -55,6 +53,13 @@ static void build_in_memory(const scene *sc, unsigned levels, build_method metho
     assert_int_equal(oct_open_memory(b->bytes, b->size, 0, &b->file, &off), OCT_OK);
     b->tree = oct_get_tree(b->file);
     assert_int_equal(b->tree->voxel_count, b->st.voxels);
+}
+
+static void build_in_memory(const scene *sc, unsigned levels, build_method method, unsigned threads,
+                            built *b)
+{
+    build_params bp = {levels, method, threads, NULL, NULL, 0};
+    build_with(sc, &bp, b);
 }
 
 static void built_free(built *b)
@@ -203,6 +208,40 @@ static void test_output_independent_of_threads(void **state)
     built_free(&one);
     built_free(&two);
     scene_free(sc);
+}
+
+/* shell_only makes the same voxels (tree and surfaces) as a full build,
+ * every record 0: at levels where the leaf-parents' records are made
+ * together (8) and below (6), on one surface and on several. */
+static void test_shell_only_same_voxels(void **state)
+{
+    (void)state;
+    static const char *paths[] = {"scenes/blobs_b.scene", "scenes/multi.scene", "scenes/csg.scene"};
+    for (size_t k = 0; k < sizeof paths / sizeof *paths; k++)
+        for (unsigned levels = 6; levels <= (SANITIZED ? 6u : 8u); levels += 2) {
+            scene *sc = load(paths[k]);
+            build_params full = {levels, BUILD_INTERVAL, 2, NULL, NULL, 0}, shell = full;
+            shell.shell_only = 1;
+            built a, b;
+            build_with(sc, &full, &a);
+            build_with(sc, &shell, &b);
+            const oct_tree *ta = a.tree, *tb = b.tree;
+            assert_int_equal(ta->voxel_count, tb->voxel_count);
+            assert_true(ta->voxel_count > 0);
+            for (unsigned d = 0; d < levels; d++) {
+                assert_int_equal(ta->node_count[d], tb->node_count[d]);
+                assert_memory_equal(ta->groups[d], tb->groups[d],
+                                    (size_t)(ta->node_count[d] + 7) / 8 * sizeof *ta->groups[d]);
+            }
+            if (ta->surfaces)
+                assert_memory_equal(ta->surfaces, tb->surfaces, (size_t)ta->voxel_count);
+            for (uint64_t v = 0; v < tb->voxel_count; v++)
+                assert_int_equal(tb->voxels[v], 0);
+            assert_true(b.st.point_evals < a.st.point_evals);
+            built_free(&a);
+            built_free(&b);
+            scene_free(sc);
+        }
 }
 
 /* Sphere of radius R about C: normals radial, plane offsets the distance from
@@ -391,6 +430,7 @@ int main(void)
         cmocka_unit_test(test_interval_method_loses_nothing),
         cmocka_unit_test(test_lipschitz_method_loses_nothing),
         cmocka_unit_test(test_output_independent_of_threads),
+        cmocka_unit_test(test_shell_only_same_voxels),
         cmocka_unit_test(test_sphere_normals_and_offsets),
         cmocka_unit_test(test_normals_from_whole_function),
         cmocka_unit_test(test_undefined_half_space_is_empty),
