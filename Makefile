@@ -1,12 +1,14 @@
 # Discrete ray tracing of implicit surfaces (Stolte & Caubet): build, test, demo.
 #
 #   make                 bin/rasterize and bin/render
-#   make test            every cmocka suite and CLI test (-O2 build)
+#   make test            every cmocka suite and CLI test (-O2 build); make check
+#                        is the same
 #   make test SANITIZE=1 the same under ASan + UBSan, no recovery
 #   make demo            rasterize and render the paper's scenes into demo/*.png
 #   make bench           benchmark (see bench/README.md)
 #   make fuzz            libFuzzer targets for a bounded time (clang)
-#   make install PREFIX=/usr/local
+#   make install         programs and man pages under DESTDIR/PREFIX
+#                        (default /usr/local); make uninstall removes them
 
 PREFIX   ?= /usr/local
 SANITIZE ?= 0
@@ -53,11 +55,29 @@ ALLCFLAGS := $(BASEFLAGS) $(CFLAGS) $(SANFLAGS) $(LTOFLAGS)
 ALLLDFLAGS := $(SANFLAGS) $(LTOFLAGS) $(LDFLAGS)
 
 B := build/$(VARIANT)
+# a build for another target (make ARCHFLAGS=...) keeps its own objects
+ifeq ($(origin ARCHFLAGS),command line)
+  B := build/$(VARIANT)$(subst =,-,$(word 1,$(ARCHFLAGS)))
+endif
 
-# One library per layer; a program is its main.c plus the layers below it.
-# format/ depends on libc and zlib only; common/ is plumbing (diagnostics,
-# numbers, atomic output); common/expr/ the expression engine (scene
-# language, tapes, intervals); common/view/ cameras and images.
+# One library per layer; a program is its main.c plus the layers it may use,
+# and its link line names only those, so a call the wrong way fails to link.
+# Layers, and what each may include and link (tests/cli/layers.sh checks
+# every #include "..." against this matrix):
+#   format/          format/ only (libc and zlib)
+#   common/          common/: plumbing (diagnostics, numbers, atomic output,
+#                    version, test hooks)
+#   common/expr/     + common/        expression engine (scene language,
+#                                     tapes, intervals)
+#   common/view/     + common/        cameras and images
+#   rasterize/       + common/expr/ common/ format/
+#   render/          + common/view/ common/expr/ common/ format/  (the expression
+#                    engine evaluates the surface tapes a 1.1 file stores)
+#   bench/           + render/ common/expr/ common/view/ common/ format/
+#                    (measurement tools and their helpers, bench/README.md;
+#                    bench/tree_util builds synthetic trees for bench and tests)
+#   tests/           everything, bench/ included; nothing includes tests/.
+# So tests sit on top and bench below them: bench never reaches into tests/.
 FORMAT_SRC    := $(wildcard format/*.c)
 COMMON_SRC    := $(wildcard common/*.c)
 EXPR_SRC      := $(wildcard common/expr/*.c)
@@ -73,15 +93,24 @@ obj = $(patsubst %.c,$(B)/%.o,$(1))
 
 LIB_FORMAT    := $(B)/libformat.a
 LIB_COMMON    := $(B)/libcommon.a
+# common/ again with DDA_TEST_HOOKS (ATOMIC_FAULT, DDA_FPE_TRAPS): only the
+# test suites and the $(B)/testbin programs the CLI tests run link it.
+LIB_COMMON_HOOKS := $(B)/libcommon_hooks.a
 LIB_EXPR      := $(B)/libexpr.a
 LIB_VIEW      := $(B)/libview.a
 LIB_RASTERIZE := $(B)/librasterize.a
 LIB_RENDER    := $(B)/librender.a
 LIB_BENCH     := $(B)/libbench.a
 LIB_TEST      := $(B)/libtestutil.a
-LIBS := $(LIB_RENDER) $(LIB_RASTERIZE) $(LIB_BENCH) $(LIB_EXPR) $(LIB_VIEW) $(LIB_COMMON) $(LIB_FORMAT)
+
+LIBS_RASTERIZE = $(LIB_RASTERIZE) $(LIB_EXPR) $(1) $(LIB_FORMAT)
+LIBS_RENDER    = $(LIB_RENDER) $(LIB_VIEW) $(LIB_EXPR) $(LIB_FORMAT) $(1)
+LIBS_BENCH     = $(LIB_BENCH) $(LIB_RENDER) $(LIB_EXPR) $(LIB_VIEW) $(1) $(LIB_FORMAT)
+LIBS_TEST      = $(LIB_TEST) $(LIB_BENCH) $(LIB_RENDER) $(LIB_RASTERIZE) $(LIB_EXPR) $(LIB_VIEW) \
+                 $(LIB_COMMON_HOOKS) $(LIB_FORMAT)
 
 PROGRAMS   := $(patsubst %/main.c,$(B)/bin/%,$(wildcard rasterize/main.c render/main.c))
+TEST_PROGRAMS := $(patsubst $(B)/bin/%,$(B)/testbin/%,$(PROGRAMS))
 BENCH_PROGS := $(patsubst bench/%_main.c,$(B)/bin/%,$(wildcard bench/*_main.c))
 TEST_BINS  := $(patsubst tests/%.c,$(B)/tests/%,$(TEST_SRC))
 # Each fuzz target also links against a plain main() that replays its corpus
@@ -90,10 +119,10 @@ REPLAY_BINS := $(patsubst tests/fuzz/%.c,$(B)/tests/replay_%,$(FUZZ_SRC))
 FUZZ_BINS   := $(patsubst tests/fuzz/%.c,$(B)/fuzz/%,$(FUZZ_SRC))
 FUZZ_TIME   ?= 60
 
-.PHONY: all test demo bench bench-quick fuzz fuzz-run clean install deps deps-test tools
+.PHONY: all test check demo bench bench-quick fuzz fuzz-run clean install uninstall deps deps-test tools FORCE
 .DEFAULT_GOAL := all
 # Keep objects that only pattern rules mention (test and fuzz mains).
-.PRECIOUS: $(B)/%.o
+.PRECIOUS: $(B)/%.o $(B)/hooks/%.o
 
 ifeq ($(VARIANT),rel)
 all: $(patsubst $(B)/bin/%,bin/%,$(PROGRAMS))
@@ -109,9 +138,26 @@ tools: $(BENCH_PROGS)
 $(B)/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(ALLCFLAGS) -MMD -MP -c $< -o $@
+$(B)/hooks/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(ALLCFLAGS) -DDDA_TEST_HOOKS -MMD -MP -c $< -o $@
+
+# --version: VERSION plus the checkout's commit (none outside a checkout).
+# The stamp changes only when that string does, so version.o rebuilds then.
+DDA_VERSION := $(shell cat VERSION)
+# (Only this tree's own .git: an unpacked tarball inside another checkout
+# must not take that checkout's commit.)
+DDA_COMMIT  := $(if $(wildcard .git),$(shell git describe --always --dirty 2>/dev/null))
+VERSION_DEFS := -DDDA_VERSION='"$(DDA_VERSION)"' -DDDA_COMMIT='"$(DDA_COMMIT)"'
+$(B)/version.stamp: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(VERSION_DEFS)' | cmp -s - $@ || echo '$(VERSION_DEFS)' > $@
+$(B)/common/version.o $(B)/hooks/common/version.o: ALLCFLAGS += $(VERSION_DEFS)
+$(B)/common/version.o $(B)/hooks/common/version.o: $(B)/version.stamp
 
 $(LIB_FORMAT): $(call obj,$(FORMAT_SRC))
 $(LIB_COMMON): $(call obj,$(COMMON_SRC))
+$(LIB_COMMON_HOOKS): $(patsubst %.c,$(B)/hooks/%.o,$(COMMON_SRC))
 $(LIB_EXPR): $(call obj,$(EXPR_SRC))
 $(LIB_VIEW): $(call obj,$(VIEW_SRC))
 $(LIB_RASTERIZE): $(call obj,$(RASTERIZE_SRC))
@@ -123,25 +169,29 @@ $(B)/%.a:
 	rm -f $@
 	$(AR) rcs $@ $^
 
-$(B)/bin/rasterize: $(B)/rasterize/main.o $(LIBS)
-	@mkdir -p $(dir $@)
-	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIBS) $(LDLIBS)
-$(B)/bin/render: $(B)/render/main.o $(LIBS)
-	@mkdir -p $(dir $@)
-	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIBS) $(LDLIBS)
-# Benchmarks may build synthetic trees with the test utilities (tests/tree_util).
-$(B)/bin/%: $(B)/bench/%_main.o $(LIB_TEST) $(LIBS)
-	@mkdir -p $(dir $@)
-	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIB_TEST) $(LIBS) $(LDLIBS)
-
-$(B)/tests/%: $(B)/tests/%.o $(LIB_TEST) $(LIBS)
-	@mkdir -p $(dir $@)
-	$(CC) $(ALLLDFLAGS) -o $@ $< $(LIB_TEST) $(LIBS) $(LDLIBS) -lcmocka -lmpfr -lgmp
-
-$(B)/tests/replay_%: $(B)/tests/fuzz/%.o $(B)/tests/fuzz/replay_main.o $(LIB_TEST) $(LIBS)
+$(B)/bin/rasterize $(B)/testbin/rasterize: $(B)/rasterize/main.o
 	@mkdir -p $(dir $@)
 	$(CC) $(ALLLDFLAGS) -o $@ $^ $(LDLIBS)
-$(B)/fuzz/%: $(B)/tests/fuzz/%.o $(LIB_TEST) $(LIBS)
+$(B)/bin/render $(B)/testbin/render: $(B)/render/main.o
+	@mkdir -p $(dir $@)
+	$(CC) $(ALLLDFLAGS) -o $@ $^ $(LDLIBS)
+$(B)/bin/rasterize: $(call LIBS_RASTERIZE,$(LIB_COMMON))
+$(B)/testbin/rasterize: $(call LIBS_RASTERIZE,$(LIB_COMMON_HOOKS))
+$(B)/bin/render: $(call LIBS_RENDER,$(LIB_COMMON))
+$(B)/testbin/render: $(call LIBS_RENDER,$(LIB_COMMON_HOOKS))
+
+$(B)/bin/%: $(B)/bench/%_main.o $(call LIBS_BENCH,$(LIB_COMMON))
+	@mkdir -p $(dir $@)
+	$(CC) $(ALLLDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(B)/tests/%: $(B)/tests/%.o $(LIBS_TEST)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALLLDFLAGS) -o $@ $^ $(LDLIBS) -lcmocka -lmpfr -lgmp
+
+$(B)/tests/replay_%: $(B)/tests/fuzz/%.o $(B)/tests/fuzz/replay_main.o $(LIBS_TEST)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALLLDFLAGS) -o $@ $^ $(LDLIBS)
+$(B)/fuzz/%: $(B)/tests/fuzz/%.o $(LIBS_TEST)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALLLDFLAGS) -fsanitize=fuzzer -o $@ $^ $(LDLIBS)
 
@@ -159,9 +209,13 @@ deps:
 deps-test:
 	@sh tests/deps.sh test
 
+# The CLI tests run $(B)/testbin (hooks compiled in); install.sh installs
+# and runs the release $(B)/bin programs.
 test: deps-test
-	$(MAKE) --no-print-directory SANITIZE=$(SANITIZE) $(PROGRAMS) $(BENCH_PROGS) $(TEST_BINS) $(REPLAY_BINS)
+	$(MAKE) --no-print-directory SANITIZE=$(SANITIZE) $(PROGRAMS) $(TEST_PROGRAMS) $(BENCH_PROGS) \
+	    $(TEST_BINS) $(REPLAY_BINS)
 	sh tests/run.sh $(B)
+check: test
 
 demo: deps
 	$(MAKE) --no-print-directory all
@@ -174,9 +228,18 @@ bench-quick: deps
 	$(MAKE) --no-print-directory all tools
 	sh bench/run.sh quick
 
-install: all
-	install -d $(DESTDIR)$(PREFIX)/bin
-	install -m 755 bin/rasterize bin/render $(DESTDIR)$(PREFIX)/bin/
+MANDIR ?= $(PREFIX)/share/man
+MAN1   := docs/man/rasterize.1 docs/man/render.1
+MAN5   := docs/man/oct.5 docs/man/scene.5
+install: $(PROGRAMS)
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man5
+	install -m 755 $(PROGRAMS) $(DESTDIR)$(PREFIX)/bin/
+	install -m 644 $(MAN1) $(DESTDIR)$(MANDIR)/man1/
+	install -m 644 $(MAN5) $(DESTDIR)$(MANDIR)/man5/
+uninstall:
+	rm -f $(patsubst $(B)/bin/%,$(DESTDIR)$(PREFIX)/bin/%,$(PROGRAMS))
+	rm -f $(patsubst docs/man/%,$(DESTDIR)$(MANDIR)/man1/%,$(MAN1))
+	rm -f $(patsubst docs/man/%,$(DESTDIR)$(MANDIR)/man5/%,$(MAN5))
 
 clean:
 	rm -rf build bin demo

@@ -10,7 +10,7 @@
 #include "common/diag.h"
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
-#include "tests/rng.h"
+#include "bench/rng.h"
 
 #define LEVEL 10
 #define MIN_SECONDS 0.5 /* per measurement */

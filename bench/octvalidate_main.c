@@ -7,7 +7,7 @@
 #include <time.h>
 
 #include "format/oct.h"
-#include "tests/oct_testutil.h"
+#include "bench/oct_synth.h"
 
 static double seconds_now(void)
 {

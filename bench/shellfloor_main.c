@@ -15,7 +15,7 @@
 
 #include "common/diag.h"
 #include "common/parse_num.h"
-#include "tests/rng.h"
+#include "bench/rng.h"
 
 static const char usage_text[] =
     "usage: shellfloor DX,DY,DZ [--samples N]\n"

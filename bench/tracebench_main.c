@@ -12,7 +12,7 @@
 #include "common/view/image.h"
 #include "format/oct_normal.h"
 #include "render/frame.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
 
 static double now_ms(void)
 {

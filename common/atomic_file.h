@@ -5,9 +5,10 @@
  * atomic_file_abort, and on SIGINT/SIGTERM/SIGHUP (the handler only unlinks
  * and re-raises), the temporary file is removed and the target is untouched.
  *
- * Test hook: the environment variable ATOMIC_FAULT=OP:N[:ERRNO][:sticky]
- * (OP = write|fsync|close|rename, ERRNO = ENOSPC|EIO|...) makes the Nth such
- * call fail with that errno (default EIO), and every later one with :sticky. */
+ * Test hook, compiled only with DDA_TEST_HOOKS (common/test_hooks.h): the
+ * environment variable ATOMIC_FAULT=OP:N[:ERRNO][:sticky] (OP =
+ * write|fsync|close|rename, ERRNO = ENOSPC|EIO|...) makes the Nth such call
+ * fail with that errno (default EIO), and every later one with :sticky. */
 #ifndef ATOMIC_FILE_H
 #define ATOMIC_FILE_H
 

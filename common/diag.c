@@ -1,7 +1,6 @@
 /* diag: program-name-prefixed and located diagnostics on stderr. */
 #include "common/diag.h"
 
-#include <fenv.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -60,10 +59,3 @@ int diag_usage_error(const char *usage, const char *fmt, ...)
 }
 
 int diag_stderr_is_tty(void) { return isatty(STDERR_FILENO); }
-
-void diag_fpe_traps_from_env(void)
-{
-    const char *v = getenv("DDA_FPE_TRAPS");
-    if (v && strcmp(v, "1") == 0)
-        feenableexcept(FE_INVALID);
-}

@@ -2,7 +2,7 @@
  * scripts rely on:
  *     prog: message
  *     prog: path: message
- *     FILE:LINE:COLUMN: message      (scene and views files; INTERFACE.md)
+ *     FILE:LINE:COLUMN: message      (scene and views files; docs/INTERFACE.md)
  * Library code returns error codes; only a program's main() calls these. */
 #ifndef DIAG_H
 #define DIAG_H
@@ -30,13 +30,7 @@ int diag_usage_error(const char *usage, const char *fmt, ...) __attribute__((for
 /* True when stderr is a terminal (progress bars are drawn only then). */
 int diag_stderr_is_tty(void);
 
-/* DDA_FPE_TRAPS=1 in the environment (tests only): trap invalid operations
- * (NaN from 0*inf, inf-inf, sqrt(-1) ...) with SIGFPE, so a stray NaN stops
- * the run instead of reaching an output. Call first in main(); threads
- * inherit it. */
-void diag_fpe_traps_from_env(void);
-
-/* Exit codes (INTERFACE.md). */
+/* Exit codes (docs/INTERFACE.md). */
 enum { EXIT_OK = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
 
 #endif

@@ -22,10 +22,7 @@ typedef struct build_params {
      * may be NULL. */
     void (*progress)(void *ctx, double fraction);
     void *progress_ctx;
-    /* The shell alone: every voxel record is 0 and no normal or plane is
-     * made (the surface choice stays); the same voxels as a full build. The
-     * hook for `rasterize --shell-only`. */
-    int shell_only;
+    int shell_only;      /* --shell-only: voxels without records (no normals, no Newton steps) */
 } build_params;
 
 /* What the build did, for the summary and the benchmark. */

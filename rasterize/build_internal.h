@@ -176,12 +176,15 @@ static inline const double *centre_fg(worker *wk, unsigned s, const double centr
 
 /* The surface a voxel belongs to (lists at index idx): with several, the
  * one nearest its centre by the first-order distance |f| / |grad f|. Starts
- * its Newton iteration (not with shell_only and one surface) and forgets the
- * centre values (wk->cf). */
+ * its Newton iteration and forgets the centre values (wk->cf). */
 unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw);
 
-/* Appends the voxel's record (lists at index levels + 1), 0 with
- * shell_only. 0 when memory runs out (then wk->failed is set). */
+/* --shell-only: the voxel's surface without a record (no normal, no Newton
+ * steps); forgets the centre values as voxel_surface does. */
+unsigned shell_surface(worker *wk, unsigned idx, const double centre[3]);
+
+/* Appends the voxel's record (lists at index levels + 1). 0 when memory
+ * runs out (then wk->failed is set). */
 int emit_voxel(worker *wk, const interval box[3], const double centre[3]);
 
 /* The records of a leaf-parent's np voxels (children child[j], surfaces

@@ -10,32 +10,41 @@
 
 #include "common/atomic_file.h"
 #include "common/diag.h"
+#include "common/limits.h"
 #include "common/parse_num.h"
+#include "common/test_hooks.h"
+#include "common/version.h"
 #include "common/expr/scene.h"
+#include "common/expr/tape_io.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
 
 #define DEFAULT_LEVELS 10
-#define MAX_THREADS 64
 
 static const char usage_text[] =
     "usage: rasterize SCENE -o OUT.oct [--levels N] [--method interval|lipschitz]\n"
-    "                 [--threads N] [-q]\n";
+    "                 [--threads N] [--shell-only] [-q]\n";
 
 static const char help_text[] =
     "Subdivide space once around the implicit surfaces of SCENE and write the\n"
-    "voxels they pass through (normal, plane offset, surface) as a sparse octree.\n"
+    "voxels they pass through (normal, plane offset, surface) as a sparse octree,\n"
+    "with each surface's compiled function (for render --exact).\n"
     "\n"
     "  -o, --output OUT.oct   output file (written atomically: all or nothing)\n"
     "  --levels N             octree levels: a 2^N grid over the cube enclosing the\n"
-    "                         scene's bounds (1..20, default 10)\n"
+    "                         scene's bounds (1.." LIMIT_STR(OCT_MAX_LEVELS) ", default 10)\n"
     "  --method M             interval (default): drop a cell when the interval of f\n"
     "                         over it excludes 0 (Duff), with a first-order Taylor\n"
     "                         test at the finest levels; lipschitz: drop it when\n"
     "                         |f(centre)| exceeds the gradient bound (Kalra-Barr)\n"
-    "  --threads N            worker threads (default: the number of cores)\n"
+    "  --threads N            worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: the number of\n"
+    "                         cores, at most " LIMIT_STR(THREADS_DEFAULT_MAX) ")\n"
+    "  --shell-only           store only the tree and the surface functions, no\n"
+    "                         per-voxel normals and planes (much smaller; the file\n"
+    "                         renders with render --exact only)\n"
     "  -q, --quiet            no progress bar and no summary\n"
     "  -h, --help             this text\n"
+    "  --version              print the version and exit\n"
     "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 
@@ -92,15 +101,15 @@ static void print_summary(const char *out, unsigned levels, const build_stats *s
 int main(int argc, char **argv)
 {
     diag_set_progname("rasterize");
-    diag_fpe_traps_from_env();
+    test_hooks_init();
     const char *scene_path = NULL, *out_path = NULL;
     long levels = DEFAULT_LEVELS, threads = sysconf(_SC_NPROCESSORS_ONLN);
     build_method method = BUILD_INTERVAL;
-    int quiet = 0;
+    int quiet = 0, shell_only = 0;
     if (threads < 1)
         threads = 1;
-    if (threads > MAX_THREADS)
-        threads = MAX_THREADS;
+    if (threads > THREADS_DEFAULT_MAX)
+        threads = THREADS_DEFAULT_MAX;
 
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -109,8 +118,13 @@ int main(int argc, char **argv)
             fputs(usage_text, stdout);
             fputs(help_text, stdout);
             return EXIT_OK;
+        } else if (!strcmp(a, "--version")) {
+            version_print("rasterize");
+            return EXIT_OK;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;
+        } else if (!strcmp(a, "--shell-only")) {
+            shell_only = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!has_value)
                 return diag_usage_error(usage_text, "option '%s' needs a file name", a);
@@ -119,12 +133,14 @@ int main(int argc, char **argv)
             if (!has_value)
                 return diag_usage_error(usage_text, "option '%s' needs a value", a);
             if (parse_long(argv[++i], 1, OCT_MAX_LEVELS, &levels) != PARSE_OK)
-                return diag_usage_error(usage_text, "--levels: '%s' is not an integer from 1 to 20", argv[i]);
+                return diag_usage_error(usage_text, "--levels: '%s' is not an integer from 1 to %d", argv[i],
+                                        OCT_MAX_LEVELS);
         } else if (!strcmp(a, "--threads")) {
             if (!has_value)
                 return diag_usage_error(usage_text, "option '%s' needs a value", a);
-            if (parse_long(argv[++i], 1, MAX_THREADS, &threads) != PARSE_OK)
-                return diag_usage_error(usage_text, "--threads: '%s' is not an integer from 1 to 64", argv[i]);
+            if (parse_long(argv[++i], 1, THREADS_MAX, &threads) != PARSE_OK)
+                return diag_usage_error(usage_text, "--threads: '%s' is not an integer from 1 to %d", argv[i],
+                                        THREADS_MAX);
         } else if (!strcmp(a, "--method")) {
             if (!has_value)
                 return diag_usage_error(usage_text, "option '%s' needs a value", a);
@@ -152,6 +168,7 @@ int main(int argc, char **argv)
     scene *sc = NULL;
     oct_writer *w = NULL;
     atomic_file *af = NULL;
+    unsigned char *function = NULL;
     double t0 = now_seconds();
     scene_error serr;
     if (scene_load(scene_path, &sc, &serr) != 0) {
@@ -167,6 +184,17 @@ int main(int argc, char **argv)
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
     build_writer_params(sc, (unsigned)levels, palette, &wp);
+    /* every file carries the surfaces' whole tapes (format 1.1), for --exact */
+    const tape *tapes[OCT_MAX_SURFACES];
+    for (size_t s = 0; s < sc->nsurfaces; s++)
+        tapes[s] = &sc->surfaces[s].tape;
+    int trc = tape_io_encode(tapes, (unsigned)sc->nsurfaces, &function, &wp.function_size);
+    if (trc != TAPE_OK) {
+        diag_path_error(scene_path, "%s", tape_strerror(trc));
+        goto done;
+    }
+    wp.function = function;
+    wp.flags = shell_only ? OCT_FLAG_SHELL_ONLY : 0;
     oct_err err = oct_writer_create(&wp, &w);
     if (err != OCT_OK) {
         diag_path_error(scene_path, "%s", oct_strerror(err));
@@ -174,7 +202,7 @@ int main(int argc, char **argv)
     }
 
     progress pr = {!quiet && diag_stderr_is_tty(), -1};
-    build_params bp = {(unsigned)levels, method, (unsigned)threads, show_progress, &pr, 0};
+    build_params bp = {(unsigned)levels, method, (unsigned)threads, show_progress, &pr, shell_only};
     build_stats st;
     err = build_octree(sc, &bp, w, &st);
     if (err != OCT_OK) {
@@ -206,6 +234,7 @@ int main(int argc, char **argv)
 done:
     atomic_file_abort(af);
     oct_writer_free(w);
+    free(function);
     scene_free(sc);
     return status;
 }

@@ -103,10 +103,6 @@ unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton 
 {
     const unsigned ns = wk->c->nsurf;
     unsigned best = wk->act[(size_t)idx * ns];
-    if (wk->c->par->shell_only && wk->nact[idx] == 1) { /* no record: nothing to evaluate */
-        wk->cf_ok[best] = 0;
-        return best;
-    }
     if (wk->nact[idx] > 1) {
         double best_dist = INFINITY;
         for (unsigned k = 0; k < wk->nact[idx]; k++) {
@@ -140,14 +136,24 @@ static int push_voxel(worker *wk, uint32_t rec, unsigned surface)
     return 1;
 }
 
+unsigned shell_surface(worker *wk, unsigned idx, const double centre[3])
+{
+    newton nw;
+    if (wk->nact[idx] > 1)
+        return voxel_surface(wk, idx, centre, &nw);
+    unsigned s = wk->act[(size_t)idx * wk->c->nsurf];
+    wk->cf_ok[s] = 0;
+    return s;
+}
+
 int emit_voxel(worker *wk, const interval box[3], const double centre[3])
 {
     const build_ctx *c = wk->c;
     unsigned idx = c->levels + 1;
+    if (c->par->shell_only) /* --shell-only: the writer stores no record */
+        return push_voxel(wk, 0, shell_surface(wk, idx, centre));
     newton nw;
     unsigned best = voxel_surface(wk, idx, centre, &nw);
-    if (c->par->shell_only)
-        return push_voxel(wk, 0, best);
     const tape *t = c->full[best];
     double h = c->cell_edge[c->levels];
     while (newton_advance(&nw, box, h)) {
@@ -217,13 +223,13 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
                  const uint8_t *surf, newton *nw, unsigned np)
 {
     const build_ctx *c = wk->c;
-    if (c->par->shell_only) {
+    double h = c->cell_edge[c->levels];
+    uint8_t live[8];
+    if (c->par->shell_only) { /* --shell-only: the writer stores no record */
         for (unsigned j = 0; j < np && !wk->failed; j++)
             push_voxel(wk, 0, surf[j]);
         return;
     }
-    double h = c->cell_edge[c->levels];
-    uint8_t live[8];
     double H[3][3];
     int hs = -1, have_h = 0; /* the surface H was made for, and whether it could be */
     for (unsigned j = 0; j < np; j++) {

@@ -13,7 +13,7 @@
 #include "render/trace.h"
 
 #define FRAME_TILE 32 /* pixels a tile side */
-#define FRAME_BEAM_DEFAULT 32 /* beam block side: the fewest instructions measured (RENDER.md) */
+#define FRAME_BEAM_DEFAULT 32 /* beam block side: fewest instructions measured (docs/perf-log.md) */
 
 typedef struct frame_job {
     const oct_tree *tree;

@@ -11,16 +11,17 @@
 
 #include "common/view/camera.h"
 #include "common/diag.h"
+#include "common/limits.h"
 #include "common/view/image.h"
 #include "common/parse_num.h"
+#include "common/test_hooks.h"
+#include "common/version.h"
 #include "format/oct.h"
 #include "render/frame.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/views.h"
 
-/* The reader lands from another branch; until then the program builds and
- * reports that it cannot open files. */
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
@@ -34,7 +35,7 @@ static const char help_text[] =
     "\n"
     "Ray traces the voxels of FILE.oct (two-step discrete ray tracing).\n"
     "  -o OUT.png          colour image (8-bit sRGB PNG)\n"
-    "  --size WxH          image size in pixels (default 512x512, each 1..32768)\n"
+    "  --size WxH          image size in pixels (default 512x512, each 1.." LIMIT_STR(CAMERA_MAX_SIZE) ")\n"
     "  --eye, --target     camera position and aim (default: a view framing the cube)\n"
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
     "  --fov DEG           vertical field of view, in (0, 180) (default 30)\n"
@@ -48,14 +49,17 @@ static const char help_text[] =
     "                      (default 32; 0: off; same image)\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
     "  --background R,G,B  linear colour of rays that miss, 0..1 each (default 0,0,0)\n"
-    "  --threads N         worker threads (default: online CPUs)\n"
+    "  --threads N         worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: online CPUs, at most "
+    LIMIT_STR(THREADS_DEFAULT_MAX) ")\n"
     "  --views FILE        one view a line, same options as above ('#' comments)\n"
     "  --orbit N           N views on a circle around the target; -o is a pattern\n"
     "                      with one integer conversion, e.g. frame_%04d.png\n"
     "  --trust             skip the file's CRC-32 checks (a fixed cost per file); the\n"
     "                      structure is still validated in full\n"
-    "  --info              print a summary of FILE.oct\n"
+    "  --info              print a summary of FILE.oct (format version, flags,\n"
+    "                      tree, stored function, shard fields)\n"
     "  -q                  no per-view timing lines\n"
+    "  --version           print the version and exit\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
 static double now_ms(void)
@@ -147,27 +151,81 @@ static void frame_cube(const oct_tree *t, views_view *v)
     }
 }
 
-int main(int argc, char **argv)
-{
-    diag_set_progname("render");
-    diag_fpe_traps_from_env();
-    views_view base;
-    views_defaults(&base);
-    const char *oct_path = NULL, *views_path = NULL;
-    long orbit = 0, split = -1, threads = 0, beam = FRAME_BEAM_DEFAULT;
-    int refine = 0, info = 0, quiet = 0, trust = 0, status = EXIT_OK;
-    double light[3] = {0, 0, 0}, bg[3] = {0, 0, 0};
-    int has_light = 0;
-    char msg[512];
-    char *views_text = NULL;
-    views_view *list = NULL;
-    size_t nviews = 0;
-    uint8_t *rgb = NULL, *nrm = NULL;
-    float *depth = NULL, *nrm_f = NULL;
-    camera *cams = NULL;
-    oct_file *file = NULL;
-    const oct_tree *tree = NULL;
+/* The command line. */
+typedef struct render_args {
+    views_view base; /* the command line's view options */
+    const char *oct_path, *views_path;
+    long orbit, split, threads, beam;
+    int refine, info, quiet, trust;
+    double light[3], bg[3];
+    int has_light;
+} render_args;
 
+/* One value option (a known name, its value). Returns -1 when it is good,
+ * else the exit status. */
+static int parse_value_option(render_args *o, const char *a, const char *val)
+{
+    char msg[512];
+    parse_err e = PARSE_OK;
+    if (views_is_option(a)) {
+        if (views_apply(&o->base, a, val, msg, sizeof msg) != 0)
+            return diag_usage_error(usage_text, "%s", msg);
+    } else if (strcmp(a, "--views") == 0) {
+        o->views_path = val;
+    } else if (strcmp(a, "--orbit") == 0) {
+        e = parse_long(val, 1, 100000, &o->orbit);
+    } else if (strcmp(a, "--split") == 0) {
+        e = parse_long(val, 0, OCT_MAX_LEVELS, &o->split);
+    } else if (strcmp(a, "--threads") == 0) {
+        e = parse_long(val, 1, THREADS_MAX, &o->threads);
+    } else if (strcmp(a, "--beam") == 0) {
+        e = parse_long(val, 0, FRAME_TILE, &o->beam);
+    } else if (strcmp(a, "--light") == 0) {
+        e = parse_vec3(val, o->light);
+        o->has_light = 1;
+        if (e == PARSE_OK && o->light[0] == 0 && o->light[1] == 0 && o->light[2] == 0)
+            return diag_usage_error(usage_text, "--light: %s: must not be the zero vector", val);
+    } else if (strcmp(a, "--background") == 0) {
+        e = parse_vec3(val, o->bg);
+        for (int k = 0; k < 3 && e == PARSE_OK; k++)
+            if (!(o->bg[k] >= 0.0 && o->bg[k] <= 1.0))
+                e = PARSE_RANGE;
+    }
+    if (e != PARSE_OK) {
+        snprintf(msg, sizeof msg, "%s: '%s': %s", a, val, parse_strerror(e));
+        return diag_usage_error(usage_text, "%s", msg);
+    }
+    return -1;
+}
+
+/* The options' combinations that cannot work. Returns -1 when they are
+ * good, else the exit status. */
+static int check_args(const render_args *o)
+{
+    if (!o->oct_path)
+        return diag_usage_error(usage_text, "%s", "no input file");
+    if (o->views_path && o->orbit)
+        return diag_usage_error(usage_text, "%s", "--views and --orbit cannot be combined");
+    if (o->views_path && o->base.out)
+        return diag_usage_error(usage_text, "%s", "-o goes into the views file with --views");
+    if (!o->views_path && !o->base.out && !o->info)
+        return diag_usage_error(usage_text, "%s", "no output: give -o OUT.png or --views FILE");
+    if (o->orbit && views_check_pattern(o->base.out) != 0)
+        return diag_usage_error(usage_text, "--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
+                           o->base.out);
+    if (o->orbit && (o->base.depth || o->base.normals))
+        return diag_usage_error(usage_text, "%s", "--orbit writes colour images only (no --depth or --normals)");
+    return -1;
+}
+
+/* Parses the command line into o. Returns -1 to go on, else the exit
+ * status (--help, bad usage). */
+static int parse_args(int argc, char **argv, render_args *o)
+{
+    memset(o, 0, sizeof *o);
+    views_defaults(&o->base);
+    o->split = -1;
+    o->beam = FRAME_BEAM_DEFAULT;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -176,26 +234,23 @@ int main(int argc, char **argv)
             fputs(help_text, stdout);
             return EXIT_OK;
         }
+        if (strcmp(a, "--version") == 0) {
+            version_print("render");
+            return EXIT_OK;
+        }
         if (a[0] != '-' || a[1] == '\0') {
-            if (oct_path)
+            if (o->oct_path)
                 return diag_usage_error(usage_text, "unexpected argument '%s'", a);
-            oct_path = a;
+            o->oct_path = a;
             continue;
         }
-        if (strcmp(a, "--refine") == 0) {
-            refine = 1;
-            continue;
-        }
-        if (strcmp(a, "--info") == 0) {
-            info = 1;
-            continue;
-        }
-        if (strcmp(a, "--trust") == 0) {
-            trust = 1;
-            continue;
-        }
-        if (strcmp(a, "-q") == 0) {
-            quiet = 1;
+        int *flag = strcmp(a, "--refine") == 0 ? &o->refine
+                    : strcmp(a, "--info") == 0 ? &o->info
+                    : strcmp(a, "--trust") == 0 ? &o->trust
+                    : strcmp(a, "-q") == 0     ? &o->quiet
+                                               : NULL;
+        if (flag) {
+            *flag = 1;
             continue;
         }
         int known = views_is_option(a) || strcmp(a, "--views") == 0 ||
@@ -207,137 +262,105 @@ int main(int argc, char **argv)
         if (!val)
             return diag_usage_error(usage_text, "option '%s' needs a value", a);
         i++;
-        parse_err e = PARSE_OK;
-        if (views_is_option(a)) {
-            if (views_apply(&base, a, val, msg, sizeof msg) != 0)
-                return diag_usage_error(usage_text, "%s", msg);
-        } else if (strcmp(a, "--views") == 0) {
-            views_path = val;
-        } else if (strcmp(a, "--orbit") == 0) {
-            e = parse_long(val, 1, 100000, &orbit);
-        } else if (strcmp(a, "--split") == 0) {
-            e = parse_long(val, 0, OCT_MAX_LEVELS, &split);
-        } else if (strcmp(a, "--threads") == 0) {
-            e = parse_long(val, 1, 256, &threads);
-        } else if (strcmp(a, "--beam") == 0) {
-            e = parse_long(val, 0, FRAME_TILE, &beam);
-        } else if (strcmp(a, "--light") == 0) {
-            e = parse_vec3(val, light);
-            has_light = 1;
-            if (e == PARSE_OK && light[0] == 0 && light[1] == 0 && light[2] == 0)
-                return diag_usage_error(usage_text, "--light: %s: must not be the zero vector", val);
-        } else if (strcmp(a, "--background") == 0) {
-            e = parse_vec3(val, bg);
-            for (int k = 0; k < 3 && e == PARSE_OK; k++)
-                if (!(bg[k] >= 0.0 && bg[k] <= 1.0))
-                    e = PARSE_RANGE;
-        }
-        if (e != PARSE_OK) {
-            snprintf(msg, sizeof msg, "%s: '%s': %s", a, val, parse_strerror(e));
-            return diag_usage_error(usage_text, "%s", msg);
-        }
+        int st = parse_value_option(o, a, val);
+        if (st >= 0)
+            return st;
     }
-    if (!oct_path)
-        return diag_usage_error(usage_text, "%s", "no input file");
-    if (views_path && orbit)
-        return diag_usage_error(usage_text, "%s", "--views and --orbit cannot be combined");
-    if (views_path && base.out)
-        return diag_usage_error(usage_text, "%s", "-o goes into the views file with --views");
-    if (!views_path && !base.out && !info)
-        return diag_usage_error(usage_text, "%s", "no output: give -o OUT.png or --views FILE");
-    if (orbit && views_check_pattern(base.out) != 0)
-        return diag_usage_error(usage_text, "--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
-                           base.out);
-    if (orbit && (base.depth || base.normals))
-        return diag_usage_error(usage_text, "%s", "--orbit writes colour images only (no --depth or --normals)");
+    return check_args(o);
+}
 
-    if (views_path) {
-        views_text = read_text(views_path);
-        if (!views_text) {
-            diag_path_error(views_path, "%s", strerror(errno));
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-        views_report_ctx rc = {views_path};
-        int r = views_parse(views_text, &base, &list, &nviews, report_line, &rc);
-        if (r == -2) {
-            diag_error("out of memory");
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-        if (r != 0) {
-            status = EXIT_USAGE;
-            goto done;
-        }
-        if (nviews == 0) {
-            diag_path_error(views_path, "no views");
-            status = EXIT_USAGE;
-            goto done;
-        }
+/* Reads and parses the views file into *list. Returns EXIT_OK or the exit
+ * status. */
+static int load_views_file(const render_args *o, const views_view *base, char **text,
+                           views_view **list, size_t *nviews)
+{
+    *text = read_text(o->views_path);
+    if (!*text) {
+        diag_path_error(o->views_path, "%s", strerror(errno));
+        return EXIT_RUNTIME;
     }
-
-    {
-        uint64_t off = 0;
-        oct_err err = oct_open(oct_path, trust ? OCT_OPEN_TRUST : 0u, &file, &off);
-        if (err != OCT_OK) {
-            if (err == OCT_EIO)
-                diag_path_error(oct_path, "%s", strerror(errno));
-            else if (off)
-                diag_path_error(oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
-                                (unsigned long long)off);
-            else
-                diag_path_error(oct_path, "%s", oct_strerror(err));
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-        tree = oct_get_tree(file);
-        if (info && oct_print_info(stdout, file) != 0) {
-            diag_path_error(oct_path, "cannot print the summary");
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-    }
-    if (!views_path && !base.out)
-        goto done; /* --info only */
-    if (split > (long)tree->levels) {
-        snprintf(msg, sizeof msg, "--split %ld: the tree has only %u levels", split,
-                 (unsigned)tree->levels);
-        status = diag_usage_error(usage_text, "%s", msg);
-        goto done;
-    }
-
-    if (!views_path) {
-        frame_cube(tree, &base);
-        if (orbit) {
-            list = views_orbit(&base, (unsigned)orbit, base.out);
-            if (!list) {
-                status = diag_usage_error(usage_text, "%s", "--orbit: the eye lies on the up axis through the target");
-                goto done;
-            }
-            nviews = (size_t)orbit;
-        } else {
-            list = malloc(sizeof *list);
-            if (!list) {
-                diag_error("out of memory");
-                status = EXIT_RUNTIME;
-                goto done;
-            }
-            list[0] = base;
-            nviews = 1;
-        }
-    }
-
-    /* Check every view before rendering any. */
-    cams = calloc(nviews, sizeof *cams);
-    if (!cams) {
+    views_report_ctx rc = {o->views_path};
+    int r = views_parse(*text, base, list, nviews, report_line, &rc);
+    if (r == -2) {
         diag_error("out of memory");
-        status = EXIT_RUNTIME;
-        goto done;
+        return EXIT_RUNTIME;
+    }
+    if (r != 0)
+        return EXIT_USAGE;
+    if (*nviews == 0) {
+        diag_path_error(o->views_path, "no views");
+        return EXIT_USAGE;
+    }
+    return EXIT_OK;
+}
+
+/* Maps the .oct file (and prints its summary with --info). Returns EXIT_OK
+ * or the exit status. */
+static int open_tree(const render_args *o, oct_file **file)
+{
+    oct_fault fault;
+    oct_err err = oct_open_fault(o->oct_path, o->trust ? OCT_OPEN_TRUST : 0u, file, &fault);
+    if (err != OCT_OK) {
+        if (err == OCT_EIO)
+            diag_path_error(o->oct_path, "%s", strerror(errno));
+        else if (fault.offset) /* what: the broken rule, without "corrupt: " */
+            diag_path_error(o->oct_path, "corrupt: %s at offset %llu", fault.what,
+                            (unsigned long long)fault.offset);
+        else
+            diag_path_error(o->oct_path, "%s", oct_strerror(err));
+        return EXIT_RUNTIME;
+    }
+    if (o->info && oct_print_info(stdout, *file) != 0) {
+        diag_path_error(o->oct_path, "cannot print the summary");
+        return EXIT_RUNTIME;
+    }
+    return EXIT_OK;
+}
+
+/* The views of the command line alone: one, or --orbit's circle. Returns
+ * EXIT_OK or the exit status. */
+static int command_line_views(const oct_tree *tree, const render_args *o, views_view *base,
+                              views_view **list, size_t *nviews)
+{
+    frame_cube(tree, base);
+    if (o->orbit) {
+        *list = views_orbit(base, (unsigned)o->orbit, base->out);
+        if (!*list)
+            return diag_usage_error(usage_text, "%s", "--orbit: the eye lies on the up axis through the target");
+        *nviews = (size_t)o->orbit;
+        return EXIT_OK;
+    }
+    *list = malloc(sizeof **list);
+    if (!*list) {
+        diag_error("out of memory");
+        return EXIT_RUNTIME;
+    }
+    (*list)[0] = *base;
+    *nviews = 1;
+    return EXIT_OK;
+}
+
+/* The image buffers, each as large as the largest view needs. */
+typedef struct render_buffers {
+    uint8_t *rgb, *nrm;
+    float *depth, *nrm_f;
+} render_buffers;
+
+/* Checks every view before rendering any (its camera, its size), sets up
+ * the cameras and allocates the buffers. Returns EXIT_OK or the exit status. */
+static int prepare_views(const oct_tree *tree, const char *views_path, views_view *list,
+                         size_t nviews, camera **cams, render_buffers *buf)
+{
+    int status = EXIT_OK;
+    *cams = calloc(nviews, sizeof **cams);
+    if (!*cams) {
+        diag_error("out of memory");
+        return EXIT_RUNTIME;
     }
     size_t max_px = 0;
     for (size_t k = 0; k < nviews; k++) {
         frame_cube(tree, &list[k]);
-        camera_err ce = camera_init(&cams[k], list[k].eye, list[k].target, list[k].up,
+        camera_err ce = camera_init(&(*cams)[k], list[k].eye, list[k].target, list[k].up,
                                     list[k].fov, list[k].width, list[k].height);
         if (ce != CAMERA_OK) {
             if (list[k].line)
@@ -355,8 +378,8 @@ int main(int argc, char **argv)
         }
     }
     if (status != EXIT_OK)
-        goto done;
-    rgb = malloc(max_px * 3);
+        return status;
+    buf->rgb = malloc(max_px * 3);
     int want_depth = 0, want_nrm = 0, want_nrm_f = 0;
     for (size_t k = 0; k < nviews; k++) {
         want_depth |= list[k].depth != NULL;
@@ -364,86 +387,146 @@ int main(int argc, char **argv)
         want_nrm_f |= list[k].normals != NULL && is_pfm(list[k].normals);
     }
     if (want_depth)
-        depth = malloc(max_px * sizeof *depth);
+        buf->depth = malloc(max_px * sizeof *buf->depth);
     if (want_nrm)
-        nrm = malloc(max_px * 3);
+        buf->nrm = malloc(max_px * 3);
     if (want_nrm_f)
-        nrm_f = malloc(max_px * 3 * sizeof *nrm_f);
-    if (!rgb || (want_depth && !depth) || (want_nrm && !nrm) || (want_nrm_f && !nrm_f)) {
+        buf->nrm_f = malloc(max_px * 3 * sizeof *buf->nrm_f);
+    if (!buf->rgb || (want_depth && !buf->depth) || (want_nrm && !buf->nrm) ||
+        (want_nrm_f && !buf->nrm_f)) {
         diag_error("out of memory for a %zu-pixel image", max_px);
-        status = EXIT_RUNTIME;
-        goto done;
+        return EXIT_RUNTIME;
     }
-    if (threads == 0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        threads = n < 1 ? 1 : n > 64 ? 64 : n;
-    }
+    return EXIT_OK;
+}
 
+/* Renders one view and writes its images; adds its time and rays to the
+ * totals. Returns EXIT_OK or EXIT_RUNTIME. */
+static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
+                       const camera *cam, const render_buffers *buf, double *total_ms,
+                       uint64_t *total_rays)
+{
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = tree;
+    job.cam = cam;
+    job.opts.split = o->split < 0 ? tree->levels : (unsigned)o->split;
+    job.opts.refine = o->refine;
+    job.shade.ambient = 0.15f;
+    for (int a = 0; a < 3; a++)
+        job.shade.background[a] = (float)o->bg[a];
+    if (o->has_light)
+        shade_set_light(&job.shade, o->light);
+    else
+        shade_default_light(cam, job.shade.light);
+    job.rgb = buf->rgb;
+    job.depth = v->depth ? buf->depth : NULL;
+    job.normals = v->normals && !is_pfm(v->normals) ? buf->nrm : NULL;
+    job.normals_f = v->normals && is_pfm(v->normals) ? buf->nrm_f : NULL;
+    job.threads = (unsigned)o->threads;
+    job.beam_size = (unsigned)o->beam;
+    if (!o->quiet && diag_stderr_is_tty())
+        job.progress = progress_bar;
+    frame_stats st;
+    double t0 = now_ms();
+    frame_render(&job, &st);
+    double ms = now_ms() - t0;
+    *total_ms += ms;
+    *total_rays += st.rays;
+    const char *op = NULL;
+    const uint32_t w = (uint32_t)v->width, h = (uint32_t)v->height;
+    if (image_write_png(v->out, buf->rgb, w, h, &op) != 0) {
+        diag_path_error(v->out, "%s: %s", op ? op : "write", strerror(errno));
+        return EXIT_RUNTIME;
+    }
+    if (v->depth && image_write_pfm(v->depth, buf->depth, w, h, &op) != 0) {
+        diag_path_error(v->depth, "%s: %s", op ? op : "write", strerror(errno));
+        return EXIT_RUNTIME;
+    }
+    if (v->normals &&
+        (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, buf->nrm_f, w, h, &op)
+                            : image_write_png(v->normals, buf->nrm, w, h, &op)) != 0) {
+        diag_path_error(v->normals, "%s: %s", op ? op : "write", strerror(errno));
+        return EXIT_RUNTIME;
+    }
+    if (!o->quiet)
+        fprintf(stderr, "render: %s: %ux%u, %.1f ms, %.2f Mrays/s, %.1f%% hit\n", v->out, w, h,
+                ms, ms > 0 ? (double)st.rays / ms / 1e3 : 0.0,
+                100.0 * (double)st.hits / (double)st.rays);
+    return EXIT_OK;
+}
+
+/* The view loop: every view in turn, then the totals line. */
+static int render_views(const oct_tree *tree, const render_args *o, const views_view *list,
+                        size_t nviews, const camera *cams, const render_buffers *buf)
+{
     double total_ms = 0.0;
     uint64_t total_rays = 0;
     for (size_t k = 0; k < nviews; k++) {
-        const views_view *v = &list[k];
-        frame_job job;
-        memset(&job, 0, sizeof job);
-        job.tree = tree;
-        job.cam = &cams[k];
-        job.opts.split = split < 0 ? tree->levels : (unsigned)split;
-        job.opts.refine = refine;
-        job.shade.ambient = 0.15f;
-        for (int a = 0; a < 3; a++)
-            job.shade.background[a] = (float)bg[a];
-        if (has_light)
-            shade_set_light(&job.shade, light);
-        else
-            shade_default_light(&cams[k], job.shade.light);
-        job.rgb = rgb;
-        job.depth = v->depth ? depth : NULL;
-        job.normals = v->normals && !is_pfm(v->normals) ? nrm : NULL;
-        job.normals_f = v->normals && is_pfm(v->normals) ? nrm_f : NULL;
-        job.threads = (unsigned)threads;
-        job.beam_size = (unsigned)beam;
-        if (!quiet && diag_stderr_is_tty())
-            job.progress = progress_bar;
-        frame_stats st;
-        double t0 = now_ms();
-        frame_render(&job, &st);
-        double ms = now_ms() - t0;
-        total_ms += ms;
-        total_rays += st.rays;
-        const char *op = NULL;
-        const uint32_t w = (uint32_t)v->width, h = (uint32_t)v->height;
-        if (image_write_png(v->out, rgb, w, h, &op) != 0) {
-            diag_path_error(v->out, "%s: %s", op ? op : "write", strerror(errno));
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-        if (v->depth && image_write_pfm(v->depth, depth, w, h, &op) != 0) {
-            diag_path_error(v->depth, "%s: %s", op ? op : "write", strerror(errno));
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-        if (v->normals && (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, nrm_f, w, h, &op)
-                                              : image_write_png(v->normals, nrm, w, h, &op)) != 0) {
-            diag_path_error(v->normals, "%s: %s", op ? op : "write", strerror(errno));
-            status = EXIT_RUNTIME;
-            goto done;
-        }
-        if (!quiet)
-            fprintf(stderr, "render: %s: %ux%u, %.1f ms, %.2f Mrays/s, %.1f%% hit\n", v->out,
-                    w, h, ms, ms > 0 ? (double)st.rays / ms / 1e3 : 0.0,
-                    100.0 * (double)st.hits / (double)st.rays);
+        int st = render_view(tree, o, &list[k], &cams[k], buf, &total_ms, &total_rays);
+        if (st != EXIT_OK)
+            return st;
     }
-    if (!quiet)
+    if (!o->quiet)
         fprintf(stderr, "render: %zu view%s, %.2f Mrays in %.1f ms, %.2f Mrays/s, %ld thread%s\n",
                 nviews, nviews == 1 ? "" : "s", (double)total_rays / 1e6, total_ms,
-                total_ms > 0 ? (double)total_rays / total_ms / 1e3 : 0.0, threads,
-                threads == 1 ? "" : "s");
+                total_ms > 0 ? (double)total_rays / total_ms / 1e3 : 0.0, o->threads,
+                o->threads == 1 ? "" : "s");
+    return EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+    diag_set_progname("render");
+    test_hooks_init();
+    render_args o;
+    int status = parse_args(argc, argv, &o);
+    if (status >= 0)
+        return status;
+    status = EXIT_OK;
+    char *views_text = NULL;
+    views_view *list = NULL;
+    size_t nviews = 0;
+    render_buffers buf = {NULL, NULL, NULL, NULL};
+    camera *cams = NULL;
+    oct_file *file = NULL;
+
+    if (o.views_path)
+        status = load_views_file(&o, &o.base, &views_text, &list, &nviews);
+    if (status == EXIT_OK)
+        status = open_tree(&o, &file);
+    if (status != EXIT_OK || (!o.views_path && !o.base.out))
+        goto done; /* an error, or --info only */
+    if (oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) { /* only the function can place hits */
+        diag_path_error(o.oct_path, "stores no normals (rasterized with --shell-only): use --exact");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
+    const oct_tree *tree = oct_get_tree(file);
+    if (o.split > (long)tree->levels) {
+        char msg[512];
+        snprintf(msg, sizeof msg, "--split %ld: the tree has only %u levels", o.split,
+                 (unsigned)tree->levels);
+        status = diag_usage_error(usage_text, "%s", msg);
+        goto done;
+    }
+    if (!o.views_path)
+        status = command_line_views(tree, &o, &o.base, &list, &nviews);
+    if (status == EXIT_OK)
+        status = prepare_views(tree, o.views_path, list, nviews, &cams, &buf);
+    if (status != EXIT_OK)
+        goto done;
+    if (o.threads == 0) {
+        long n = sysconf(_SC_NPROCESSORS_ONLN);
+        o.threads = n < 1 ? 1 : n > THREADS_DEFAULT_MAX ? THREADS_DEFAULT_MAX : n;
+    }
+    status = render_views(tree, &o, list, nviews, cams, &buf);
 
 done:
-    free(rgb);
-    free(depth);
-    free(nrm);
-    free(nrm_f);
+    free(buf.rgb);
+    free(buf.depth);
+    free(buf.nrm);
+    free(buf.nrm_f);
     free(cams);
     free(list);
     free(views_text);

@@ -1,7 +1,9 @@
 /* trace: the two-step discrete ray traversal of an oct_tree (Stolte & Caubet,
  * sections 3-4): clip to the root cube, skip empty cells down to the split
- * depth K, then walk voxel by voxel, looking occupancy up from the common
- * ancestor, kept on a stack (see RENDER.md, "Traversal").
+ * depth K (step one: `enter`, the paper's vertical traverse, and `climb` to
+ * the common ancestor, the nodes kept on a stack), then walk voxel by voxel
+ * (step two, `voxel_walk`). See RENDER.md, "Traversal"; the implementations
+ * are in trace_sse.c and trace_portable.c (trace_impl.h).
  *
  * Coordinates. The ray is mapped to grid coordinates, where the root cube is
  * [0, N]^3 with N = 2^L voxels a side: g = (p - origin) * N / edge. The

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "common/view/camera.h"
+#include "common/limits.h"
 #include "common/parse_num.h"
 
 void views_defaults(views_view *v)
@@ -66,7 +67,7 @@ int views_apply(views_view *v, const char *name, const char *value, char *msg, s
     }
     if (e != PARSE_OK) {
         snprintf(msg, n, "%s: '%s': %s%s", name, value, parse_strerror(e),
-                 strcmp(name, "--size") == 0 ? " (WxH, 1..32768 each)" : "");
+                 strcmp(name, "--size") == 0 ? " (WxH, 1.." LIMIT_STR(CAMERA_MAX_SIZE) " each)" : "");
         return -1;
     }
     return 0;

@@ -1,6 +1,8 @@
 #!/bin/sh
 # Installs the libraries the build needs when they are missing (Debian/Ubuntu).
 # Usage: tests/deps.sh build|test
+# `make test` (and `make check`) run it first; it says what it will install
+# before it calls apt-get.
 set -u
 need=""
 pkg-config --exists libpng 2>/dev/null || need="$need libpng-dev"
@@ -11,6 +13,7 @@ command -v gcc-ar >/dev/null           || need="$need gcc"  # the release build'
 if [ "${1:-build}" = test ]; then
     pkg-config --exists cmocka 2>/dev/null || need="$need libcmocka-dev"
     [ -f /usr/include/mpfr.h ]             || need="$need libmpfr-dev"  # interval tests check against MPFR
+    command -v groff >/dev/null            || need="$need groff"        # install.sh formats the man pages
 fi
 [ -z "$need" ] && exit 0
 if ! command -v apt-get >/dev/null; then
@@ -19,6 +22,8 @@ if ! command -v apt-get >/dev/null; then
 fi
 sudo=""
 [ "$(id -u)" -ne 0 ] && sudo=sudo
-echo "deps: installing$need with apt-get" >&2
+# Said before anything runs, so nobody is surprised by a password prompt.
+echo "deps: missing:$need" >&2
+echo "deps: installing them now with ${sudo:+sudo }apt-get update and apt-get install" >&2
 $sudo apt-get update -qq || exit 1
 DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq $need >/dev/null || exit 1

@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #include "format/oct.h"
-#include "tests/oct_testutil.h"
+#include "bench/oct_synth.h"
 
 /* Asserts that the opened file holds exactly t: header fields, counts, masks,
  * voxel records, surfaces and palette, and that a walk from the root through

@@ -3,9 +3,13 @@
 #   "tests: N passed, N failed"
 # Usage: tests/run.sh BUILD_DIR    (e.g. build/rel or build/san)
 # cmocka suites count each test case; CLI scripts and fuzz replays count once each.
+# CLI tests run $BIN = BUILD_DIR/testbin, the programs built with the test
+# hooks (ATOMIC_FAULT, DDA_FPE_TRAPS); $RELBIN = BUILD_DIR/bin are the
+# release programs (install.sh installs and runs those).
 set -u
 B=${1:?usage: tests/run.sh BUILD_DIR}
-mkdir -p "$B/bin"; BIN=$(cd "$B/bin" && pwd); export BIN
+mkdir -p "$B/bin" "$B/testbin"
+BIN=$(cd "$B/testbin" && pwd); RELBIN=$(cd "$B/bin" && pwd); export BIN RELBIN
 ROOT=$(pwd); export ROOT
 passed=0; failed=0; failures=""
 log=$(mktemp); trap 'rm -f "$log"' EXIT

@@ -1,4 +1,4 @@
-/* Tests for common/view/camera: INTERFACE.md's formula by hand, exact centre rays
+/* Tests for common/view/camera: docs/INTERFACE.md's formula by hand, exact centre rays
  * for odd sizes, rejections. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,4 +1,4 @@
-/* Tests for common/view/image: PFM bytes exactly as INTERFACE.md, PNG read back
+/* Tests for common/view/image: PFM bytes exactly as docs/INTERFACE.md, PNG read back
  * with libpng, failures leave no file. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -14,7 +14,7 @@
 #include <time.h>
 
 #include "common/expr/interval.h"
-#include "tests/rng.h"
+#include "bench/rng.h"
 
 #ifdef __FAST_MATH__
 #error "fast-math breaks the interval arithmetic; build without it"

@@ -14,8 +14,8 @@
 
 #include "format/oct.h"
 #include "format/oct_normal.h"
-#include "tests/oct_testutil.h"
-#include "tests/rng.h"
+#include "bench/oct_synth.h"
+#include "bench/rng.h"
 
 static void test_normal_codec_error(void **state)
 {

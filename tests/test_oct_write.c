@@ -15,7 +15,7 @@
 
 #include "format/oct.h"
 #include "format/oct_layout.h" /* oct__alloc_fail_after */
-#include "tests/oct_testutil.h"
+#include "bench/oct_synth.h"
 
 static void test_writer_usage_errors(void **state)
 {

@@ -1,6 +1,7 @@
 /* Tests for render/trace: the two-step traversal against a brute-force oracle
  * that slab-tests every voxel, for every split K, on random sparse trees and
- * deep single-path trees; degenerate rays; the step bound. */
+ * deep single-path trees; degenerate rays; the step bound. Every cast runs
+ * each traversal implementation built (tests/trace_oracle.h). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,57 +15,15 @@
 
 #include "format/oct_normal.h"
 #include "render/trace.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
+#include "tests/trace_oracle.h"
 
-/* xorshift64*: deterministic, seedable */
 static uint64_t rng_state = 0x9e3779b97f4a7c15u;
-static uint64_t rng(void)
-{
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return rng_state * 0x2545f4914f6cdd1dULL;
-}
+static uint64_t rng(void) { return rng_xorshift64star(&rng_state); }
 static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
 
-/* The oracle: first voxel of the list whose occupancy interval (trace.h's
- * tie rule, times from trace_plane_time) is non-empty and starts at or after
- * local 0. Returns the list index or -1. */
-static long oracle(const trace_ray *r, unsigned levels, const uint32_t (*vox)[3], size_t n,
-                   double *t_out)
-{
-    const uint32_t lim = UINT32_C(1) << levels;
-    long best = -1;
-    double best_t = INFINITY;
-    for (size_t i = 0; i < n; i++) {
-        double lo = 0.0, hi = INFINITY;
-        int ok = 1;
-        for (int a = 0; a < 3 && ok; a++) {
-            double k = (double)vox[i][a];
-            if (!(r->active >> a & 1)) {
-                double f = floor(r->o[a]);
-                uint32_t kz = f >= (double)lim ? lim - 1 : (uint32_t)f;
-                ok = vox[i][a] == kz;
-                continue;
-            }
-            double en = trace_plane_time(r, a, r->sgn[a] > 0 ? k : k + 1);
-            double ex = trace_plane_time(r, a, r->sgn[a] > 0 ? k + 1 : k);
-            if (en > lo)
-                lo = en;
-            if (ex < hi)
-                hi = ex;
-        }
-        if (ok && lo < hi && lo < best_t) {
-            best_t = lo;
-            best = (long)i;
-        }
-    }
-    *t_out = best_t;
-    return best;
-}
-
-/* --refine oracle, written from the rule of refine_voxel (trace.c) without
+/* --refine oracle, written from the rule of trace_refine_voxel without
  * the traversal: the voxels the ray occupies for a non-empty time [lo, hi)
  * in the order of lo; a run is a sequence of them each starting where the
  * previous one ends (no empty cell between). The ray hits the first voxel
@@ -178,7 +137,7 @@ static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, 
     trace_ray r;
     int in = trace_setup(tree, eye, dir, &r);
     double ot = INFINITY;
-    long want = in ? oracle(&r, tree->levels, vox, n, &ot) : -1;
+    long want = in ? trace_oracle_first(&r, tree->levels, vox, n, &ot) : -1;
     st->rays++;
     if (want >= 0)
         st->hits++;
@@ -189,7 +148,7 @@ static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, 
             if (refine) {
                 trace_opts ro = {k, 1};
                 trace_hit rh;
-                trace_ray_cast(tree, &ro, eye, dir, &rh);
+                trace_cast_all(tree, &ro, eye, dir, &rh);
                 st->traces++;
                 assert_true(rh.steps <= trace_max_steps(tree->levels));
                 assert_int_equal(rh.hit, want_refined >= 0);
@@ -201,7 +160,7 @@ static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, 
             }
             trace_opts opts = {k, refine};
             trace_hit h;
-            trace_ray_cast(tree, &opts, eye, dir, &h);
+            trace_cast_all(tree, &opts, eye, dir, &h);
             st->traces++;
             assert_true(h.steps <= trace_max_steps(tree->levels));
             if (want < 0) {
@@ -374,31 +333,31 @@ static void test_empty_tree_and_degenerate_rays(void **state)
     trace_opts o = {2, 0};
     trace_hit h;
     const double eye[3] = {0.5, 0.5, -1}, dir[3] = {0, 0, 1};
-    assert_int_equal(trace_ray_cast(t, &o, eye, dir, &h), 0);
+    assert_int_equal(trace_cast_all(t, &o, eye, dir, &h), 0);
     assert_int_equal(h.steps, 0);
     tree_util_free(t);
 
     static const uint32_t one[1][3] = {{0, 0, 0}};
     t = tree_util_simple(1, one, 1);
     const double zero[3] = {0, 0, 0}, nan3[3] = {NAN, 0, 1}, inf3[3] = {INFINITY, 0, 0};
-    assert_int_equal(trace_ray_cast(t, &o, eye, zero, &h), 0);
-    assert_int_equal(trace_ray_cast(t, &o, eye, nan3, &h), 0);
-    assert_int_equal(trace_ray_cast(t, &o, inf3, dir, &h), 0);
+    assert_int_equal(trace_cast_all(t, &o, eye, zero, &h), 0);
+    assert_int_equal(trace_cast_all(t, &o, eye, nan3, &h), 0);
+    assert_int_equal(trace_cast_all(t, &o, inf3, dir, &h), 0);
     /* eye inside the occupied voxel: t = 0 */
     const double in[3] = {0.25, 0.25, 0.25};
-    assert_int_equal(trace_ray_cast(t, &o, in, dir, &h), 1);
+    assert_int_equal(trace_cast_all(t, &o, in, dir, &h), 1);
     assert_true(h.t == 0.0);
     /* along the face x = 0.5 between voxel 0 and voxel 1 (x+): voxel x = 1, empty */
     const double face[3] = {0.5, 0.25, -1};
-    assert_int_equal(trace_ray_cast(t, &o, face, dir, &h), 0);
+    assert_int_equal(trace_cast_all(t, &o, face, dir, &h), 0);
     /* along the root's lower face x = 0: voxel x = 0, hit at t = 1 */
     const double lowface[3] = {0.0, 0.25, -1};
-    assert_int_equal(trace_ray_cast(t, &o, lowface, dir, &h), 1);
+    assert_int_equal(trace_cast_all(t, &o, lowface, dir, &h), 1);
     assert_true(h.t == 1.0);
     /* eye at 1e30: no NaN, finite t or miss */
     const double far[3] = {1e30, 1e30, 1e30}, back[3] = {-1, -1, -1};
     feenableexcept(FE_INVALID);
-    trace_ray_cast(t, &o, far, back, &h);
+    trace_cast_all(t, &o, far, back, &h);
     fedisableexcept(FE_INVALID);
     assert_true(!h.hit || isfinite(h.t));
     tree_util_free(t);
@@ -475,7 +434,7 @@ static void test_clip_same_hit(void **state)
                 continue;
             trace_opts plain = {L, 0};
             trace_hit hp;
-            if (!trace_ray_prepared(t, &plain, &r0, &hp))
+            if (!trace_prepared_all(t, &plain, &r0, &hp))
                 continue;
             double starts[3 * 65 + 1];
             int ns = 0;
@@ -490,12 +449,12 @@ static void test_clip_same_hit(void **state)
                 for (int refine = 0; refine <= 1; refine++) {
                     const trace_opts op = {K, refine};
                     trace_hit h0;
-                    trace_ray_prepared(t, &op, &r0, &h0);
+                    trace_prepared_all(t, &op, &r0, &h0);
                     for (int c = 0; c < ns; c++) {
                         trace_ray r = r0;
                         assert_true(trace_clip(&r, starts[c], INFINITY));
                         trace_hit h1;
-                        trace_ray_prepared(t, &op, &r, &h1);
+                        trace_prepared_all(t, &op, &r, &h1);
                         assert_int_equal(h1.hit, h0.hit);
                         assert_true(h1.voxel == h0.voxel);
                         assert_true(h1.t == h0.t);
@@ -570,7 +529,7 @@ static void test_anchored_same_hit(void **state)
                 if (!(tl >= 0.0 && tl < r0.t_end))
                     continue;
                 t_start = r0.t_base + tl;
-            } else if (how >= 2 && trace_ray_prepared(t, &whole, &r0, &hw)) {
+            } else if (how >= 2 && trace_prepared_all(t, &whole, &r0, &hw)) {
                 t_start = how == 2 ? hw.t : hw.t - urand() * 2.0 * (hw.t - r0.t_base);
                 if (!(t_start >= r0.t_base))
                     t_start = r0.t_base;
@@ -610,8 +569,8 @@ static void test_anchored_same_hit(void **state)
                 for (int refine = 0; refine <= 1; refine++) {
                     const trace_opts op = {irand(2) ? L : irand(L + 1), refine};
                     trace_hit h0, h1;
-                    trace_ray_prepared(t, &op, &rays[k], &h0);
-                    trace_ray_anchored(t, &op, &rays[k], &an, &h1);
+                    trace_prepared_all(t, &op, &rays[k], &h0);
+                    trace_anchored_all(t, &op, &rays[k], &an, &h1);
                     assert_int_equal(h1.hit, h0.hit);
                     assert_true(h1.voxel == h0.voxel || !h0.hit);
                     assert_true(h1.t == h0.t || (isinf(h1.t) && isinf(h0.t)));

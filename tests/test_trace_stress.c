@@ -22,8 +22,7 @@
  * voxels are within 2^-40 relative of the exact ray at the same time, and
  * such near ties are counted and bounded.
  *
- * Also: watertightness against closed one-voxel shells (sphere and box) at
- * levels 4-10, and the step bound, with an exact step count for K = 0. */
+ * Watertightness and the step bound: tests/test_trace_watertight.c. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -37,220 +36,20 @@
 #include <string.h>
 
 #include "render/trace.h"
-#include "tests/tree_util.h"
-
-#if defined(__SANITIZE_ADDRESS__)
-#define SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SANITIZED 1
-#endif
-#endif
-#ifndef SANITIZED
-#define SANITIZED 0
-#endif
+#include "bench/tree_util.h"
+#include "tests/exact_ray_oracle.h"
+#include "tests/sanitized.h"
+#include "tests/trace_oracle.h"
 
 /* Rays in the exact-class run on random trees (levels 1-8) and deep trees. */
 #define RANDOM_TREE_RAYS (SANITIZED ? 240000ul : 960000ul)
 #define DEEP_RAYS (SANITIZED ? 25000ul : 100000ul)
 #define GENERAL_RAYS (SANITIZED ? 50000ul : 200000ul)
 
-#define FRAC_BITS 16 /* o is a multiple of 2^-FRAC_BITS */
-
-/* xorshift64*: deterministic */
 static uint64_t rng_state = 0x243f6a8885a308d3u;
-static uint64_t rng(void)
-{
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return rng_state * 0x2545f4914f6cdd1dULL;
-}
+static uint64_t rng(void) { return rng_xorshift64star(&rng_state); }
 static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
-
-/* ---- Exact arithmetic ---------------------------------------------------- */
-
-typedef __int128 i128;
-
-/* A time (k - o) / d: num * 2^-FRAC_BITS / (dm * 2^de), dm > 0 (the sign of d
- * is folded into num). */
-typedef struct xtime {
-    i128 num;
-    int64_t dm;
-    int de;
-} xtime;
-
-/* An exact ray in grid space. */
-typedef struct xray {
-    int64_t O[3];   /* o * 2^FRAC_BITS, exact */
-    int64_t dm[3];  /* |d| = dm * 2^de */
-    int de[3];
-    int sgn[3];     /* sign of d; 0 on a zero axis */
-    double o[3], d[3];
-} xray;
-
-static int bitlen(unsigned __int128 x)
-{
-    int n = 0;
-    while (x) {
-        n++;
-        x >>= 1;
-    }
-    return n;
-}
-
-/* sign of X * 2^ex - Y * 2^ey for X, Y > 0 (unsigned, < 2^120) */
-static int cmp_scaled(unsigned __int128 X, int ex, unsigned __int128 Y, int ey)
-{
-    int bx = bitlen(X) + ex, by = bitlen(Y) + ey;
-    if (bx != by)
-        return bx < by ? -1 : 1;
-    if (ex > ey)
-        X <<= ex - ey; /* bit lengths become equal: no overflow */
-    else
-        Y <<= ey - ex;
-    return X < Y ? -1 : X > Y;
-}
-
-static int xcmp(const xtime *a, const xtime *b)
-{
-    int sa = a->num < 0 ? -1 : a->num > 0, sb = b->num < 0 ? -1 : b->num > 0;
-    if (sa != sb || sa == 0)
-        return sa < sb ? -1 : sa > sb;
-    unsigned __int128 na = (unsigned __int128)(a->num < 0 ? -a->num : a->num);
-    unsigned __int128 nb = (unsigned __int128)(b->num < 0 ? -b->num : b->num);
-    /* |a| vs |b|: na / (a.dm 2^a.de) vs nb / (b.dm 2^b.de) */
-    int c = cmp_scaled(na * (unsigned __int128)b->dm, b->de, nb * (unsigned __int128)a->dm, a->de);
-    return sa > 0 ? c : -c;
-}
-
-static xtime xplane(const xray *r, int a, int64_t k)
-{
-    xtime t;
-    t.num = ((i128)k << FRAC_BITS) - r->O[a];
-    if (r->sgn[a] < 0)
-        t.num = -t.num;
-    t.dm = r->dm[a];
-    t.de = r->de[a];
-    return t;
-}
-
-static long double xtime_ld(const xtime *t)
-{
-    return ldexpl((long double)t->num, -FRAC_BITS - t->de) / (long double)t->dm;
-}
-
-/* Fills r from grid-space o and d; returns 0 when o is not a multiple of
- * 2^-FRAC_BITS below 2^46 in magnitude (the oracle's range). */
-static int xray_init(xray *r, const double o[3], const double d[3])
-{
-    for (int a = 0; a < 3; a++) {
-        double s = ldexp(o[a], FRAC_BITS);
-        if (!(fabs(o[a]) < 0x1p46) || s != floor(s))
-            return 0;
-        r->O[a] = (int64_t)s;
-        r->o[a] = o[a];
-        r->d[a] = d[a];
-        double inv = 1.0 / d[a];
-        if (d[a] == 0.0 || !isfinite(inv)) { /* trace.h: a zero axis */
-            r->sgn[a] = 0;
-            r->dm[a] = 1;
-            r->de[a] = 0;
-            continue;
-        }
-        int e;
-        double m = frexp(fabs(d[a]), &e);
-        r->dm[a] = (int64_t)ldexp(m, 53);
-        r->de[a] = e - 53;
-        while (!(r->dm[a] & 1)) {
-            r->dm[a] >>= 1;
-            r->de[a]++;
-        }
-        r->sgn[a] = d[a] > 0 ? 1 : -1;
-    }
-    return 1;
-}
-
-/* Exact occupancy interval [tin, tout) of voxel v, tin clipped at 0.
- * Returns 0 when it is empty; *inf_out set when tout is +inf. */
-static int xvoxel(const xray *r, uint32_t lim, const uint32_t v[3], xtime *tin, xtime *tout,
-                  int *inf_out)
-{
-    xtime lo = {0, 1, 0}, hi = {0, 1, 0};
-    int hi_inf = 1;
-    for (int a = 0; a < 3; a++) {
-        if (r->sgn[a] == 0) {
-            /* zero axis: voxel floor(o), the closed upper face in N-1 */
-            if (r->O[a] < 0 || r->O[a] > ((int64_t)lim << FRAC_BITS))
-                return 0;
-            int64_t k = r->O[a] >> FRAC_BITS;
-            if (k == (int64_t)lim)
-                k--;
-            if ((int64_t)v[a] != k)
-                return 0;
-            continue;
-        }
-        int64_t k = v[a];
-        xtime en = xplane(r, a, r->sgn[a] > 0 ? k : k + 1);
-        xtime ex = xplane(r, a, r->sgn[a] > 0 ? k + 1 : k);
-        if (xcmp(&en, &lo) > 0)
-            lo = en;
-        if (hi_inf || xcmp(&ex, &hi) < 0) {
-            hi = ex;
-            hi_inf = 0;
-        }
-    }
-    if (!hi_inf && xcmp(&lo, &hi) >= 0)
-        return 0;
-    *tin = lo;
-    *tout = hi;
-    *inf_out = hi_inf;
-    return 1;
-}
-
-/* Cheap long-double pre-test: 0 only when voxel v is surely not crossed
- * (margin far above long double rounding). */
-static int maybe_crossed(const xray *r, const uint32_t v[3])
-{
-    long double lo = 0, hi = INFINITY;
-    for (int a = 0; a < 3; a++) {
-        if (r->sgn[a] == 0)
-            continue; /* the exact test decides */
-        long double k0 = (long double)v[a], o = r->o[a], d = r->d[a];
-        long double t0 = (k0 - o) / d, t1 = (k0 + 1 - o) / d;
-        long double en = t0 < t1 ? t0 : t1, ex = t0 < t1 ? t1 : t0;
-        if (en > lo)
-            lo = en;
-        if (ex < hi)
-            hi = ex;
-    }
-    return lo <= hi + 0x1p-40L * (fabsl(lo) + fabsl(hi) + 1);
-}
-
-/* First voxel of the list the exact ray occupies (smallest tin). Returns the
- * index or -1; *t_out its exact entry time (long double). */
-static long oracle_exact(const xray *r, unsigned levels, const uint32_t (*vox)[3], size_t n,
-                         long double *t_out)
-{
-    const uint32_t lim = UINT32_C(1) << levels;
-    long best = -1;
-    xtime best_t = {0, 1, 0};
-    for (size_t i = 0; i < n; i++) {
-        if (!maybe_crossed(r, vox[i]))
-            continue;
-        xtime tin, tout;
-        int inf;
-        if (!xvoxel(r, lim, vox[i], &tin, &tout, &inf))
-            continue;
-        if (best < 0 || xcmp(&tin, &best_t) < 0) {
-            best = (long)i;
-            best_t = tin;
-        }
-    }
-    *t_out = best >= 0 ? xtime_ld(&best_t) : INFINITY;
-    return best;
-}
 
 /* ---- Long-double oracle with the documented tolerance (general rays) ---- */
 
@@ -474,7 +273,7 @@ static void check_exact(const oct_tree *t, const uint32_t (*vox)[3], size_t n, c
     for (unsigned k = k_lo; k <= k_hi; k++) {
         trace_opts opts = {k, 0};
         trace_hit h;
-        trace_ray_cast(t, &opts, eye, dir, &h);
+        trace_cast_all(t, &opts, eye, dir, &h);
         st->traces++;
         if (h.steps > st->max_steps_seen)
             st->max_steps_seen = h.steps;
@@ -688,7 +487,7 @@ static void test_general_rays_tolerance(void **state)
             for (unsigned k = k0; k <= levels; k += kstep) {
                 trace_opts opts = {k, 0};
                 trace_hit h;
-                trace_ray_cast(t, &opts, eye, dir, &h);
+                trace_cast_all(t, &opts, eye, dir, &h);
                 st.traces++;
                 st.aimed_traces += aimed;
                 assert_true(h.steps <= trace_max_steps(levels));
@@ -735,204 +534,12 @@ static void test_general_rays_tolerance(void **state)
     assert_true(st.near_ties * 10000 < st.traces - st.aimed_traces);
 }
 
-/* ---- Watertightness ------------------------------------------------------ */
-
-/* Voxels whose closed cube meets the sphere |p - c| = R (grid units): a
- * one-voxel shell that separates inside from outside for 26-paths. */
-static size_t sphere_shell(unsigned levels, const double c[3], double R, uint32_t (**out)[3])
-{
-    const uint32_t lim = UINT32_C(1) << levels;
-    size_t cap = 1024, n = 0;
-    uint32_t(*v)[3] = malloc(cap * sizeof *v);
-    assert_non_null(v);
-    int lo[3], hi[3];
-    for (int a = 0; a < 3; a++) {
-        lo[a] = (int)floor(c[a] - R) - 1;
-        hi[a] = (int)ceil(c[a] + R) + 1;
-        if (lo[a] < 0)
-            lo[a] = 0;
-        if (hi[a] > (int)lim - 1)
-            hi[a] = (int)lim - 1;
-    }
-    for (int z = lo[2]; z <= hi[2]; z++)
-        for (int y = lo[1]; y <= hi[1]; y++)
-            for (int x = lo[0]; x <= hi[0]; x++) {
-                const int p[3] = {x, y, z};
-                double dmin = 0, dmax = 0;
-                for (int a = 0; a < 3; a++) {
-                    double l = p[a] - c[a], h = p[a] + 1 - c[a];
-                    double m = l > 0 ? l : h < 0 ? -h : 0;
-                    double M = fmax(fabs(l), fabs(h));
-                    dmin += m * m;
-                    dmax += M * M;
-                }
-                if (dmin <= R * R && R * R <= dmax) {
-                    if (n == cap) {
-                        cap *= 2;
-                        v = realloc(v, cap * sizeof *v);
-                        assert_non_null(v);
-                    }
-                    v[n][0] = (uint32_t)x;
-                    v[n][1] = (uint32_t)y;
-                    v[n][2] = (uint32_t)z;
-                    n++;
-                }
-            }
-    *out = v;
-    return n;
-}
-
-/* The faces of the voxel box [lo, hi]^3: a closed one-voxel wall. */
-static size_t box_shell(uint32_t lo, uint32_t hi, uint32_t (**out)[3])
-{
-    size_t cap = (size_t)(hi - lo + 1) * (hi - lo + 1) * 6 + 8, n = 0;
-    uint32_t(*v)[3] = malloc(cap * sizeof *v);
-    assert_non_null(v);
-    for (uint32_t z = lo; z <= hi; z++)
-        for (uint32_t y = lo; y <= hi; y++)
-            for (uint32_t x = lo; x <= hi; x++)
-                if (x == lo || x == hi || y == lo || y == hi || z == lo || z == hi) {
-                    assert_true(n < cap);
-                    v[n][0] = x;
-                    v[n][1] = y;
-                    v[n][2] = z;
-                    n++;
-                    if (!(y == lo || y == hi || z == lo || z == hi) && x == lo)
-                        x = hi - 1; /* skip the hollow */
-                }
-    *out = v;
-    return n;
-}
-
-/* Rays from inside aimed exactly at corners, edge points and face points of
- * shell voxels, and the same rays reversed from outside: every one hits, and
- * no later than the aimed point. */
-static void shoot_at_shell(const oct_tree *t, const uint32_t (*v)[3], size_t n, const double c[3],
-                           double R, unsigned nrays, unsigned long *count)
-{
-    const double lim = ldexp(1.0, (int)t->levels), h = t->edge / lim;
-    for (unsigned ri = 0; ri < nrays; ri++) {
-        const uint32_t *s = v[irand((uint32_t)n)];
-        double P[3];
-        unsigned kind = irand(3); /* corner, edge, face */
-        for (int a = 0; a < 3; a++) {
-            P[a] = (double)s[a] + irand(2);
-            if ((kind == 1 && a == 0) || (kind == 2 && a < 2))
-                P[a] = (double)s[a] + (double)(1 + irand(15)) / 16.0;
-        }
-        double eye[3], dir[3], far[3], back[3];
-        for (int a = 0; a < 3; a++) {
-            eye[a] = t->origin[a] + c[a] * h;
-            dir[a] = (P[a] - c[a]) * h;
-            far[a] = t->origin[a] + (P[a] + (P[a] - c[a]) * (ri % 2 ? 1.0 : 0x1p20)) * h;
-            back[a] = -dir[a];
-        }
-        for (unsigned k = 0; k <= t->levels; k++) {
-            trace_opts o = {k, 0};
-            trace_hit hin, hout;
-            trace_ray_cast(t, &o, eye, dir, &hin);
-            trace_ray_cast(t, &o, far, back, &hout);
-            if (!hin.hit || !hout.hit)
-                fail_msg("hole: L=%u K=%u aim (%.17g %.17g %.17g) from %s", t->levels, k, P[0],
-                         P[1], P[2], hin.hit ? "outside" : "inside");
-            /* from the centre, the hit is no later than the sphere (radius R
-             * in grid units; the aimed point is at t = 1) */
-            if (R > 0) {
-                double len = sqrt((P[0] - c[0]) * (P[0] - c[0]) + (P[1] - c[1]) * (P[1] - c[1]) +
-                                  (P[2] - c[2]) * (P[2] - c[2]));
-                if (!(hin.t <= R / len * (1 + 1e-12)))
-                    fail_msg("hit at t %.17g after the sphere at %.17g", hin.t, R / len);
-            }
-            assert_true(hin.steps <= trace_max_steps(t->levels));
-            assert_true(hout.steps <= trace_max_steps(t->levels));
-            (*count)++;
-        }
-    }
-}
-
-static void test_watertight_shells(void **state)
-{
-    (void)state;
-    feenableexcept(FE_INVALID);
-    unsigned long traced = 0;
-    for (unsigned levels = 4; levels <= 10; levels++) {
-        const uint32_t lim = UINT32_C(1) << levels;
-        const double origin[3] = {-1, -1, -1};
-        /* sphere: centre on a voxel corner, then off-grid */
-        for (int variant = 0; variant < 2; variant++) {
-            double c[3] = {lim / 2.0, lim / 2.0, lim / 2.0};
-            if (variant)
-                for (int a = 0; a < 3; a++)
-                    c[a] += (double)(1 + irand(255)) / 256.0 - 0.5;
-            double R = fmin(0.35 * lim, 40.0);
-            if (variant == 0)
-                R = floor(R); /* passes exactly through corners and edges */
-            uint32_t(*v)[3];
-            size_t n = sphere_shell(levels, c, R, &v);
-            oct_tree *t = tree_util_build(levels, origin, 2.0, (const uint32_t(*)[3])v, n, NULL,
-                                          NULL, 1, NULL);
-            assert_non_null(t);
-            shoot_at_shell(t, (const uint32_t(*)[3])v, n, c, R, SANITIZED ? 150 : 400, &traced);
-            tree_util_free(t);
-            free(v);
-        }
-        /* box wall */
-        uint32_t lo = lim / 4, hi = lim - lim / 4 - 1;
-        if (hi > lo + 60)
-            hi = lo + 60;
-        uint32_t(*v)[3];
-        size_t n = box_shell(lo, hi, &v);
-        oct_tree *t =
-            tree_util_build(levels, origin, 2.0, (const uint32_t(*)[3])v, n, NULL, NULL, 1, NULL);
-        assert_non_null(t);
-        const double c[3] = {(lo + hi + 1) / 2.0, (lo + hi + 1) / 2.0 + 0.25, (lo + hi + 1) / 2.0};
-        shoot_at_shell(t, (const uint32_t(*)[3])v, n, c, 0.0, SANITIZED ? 150 : 400, &traced);
-        tree_util_free(t);
-        free(v);
-    }
-    fedisableexcept(FE_INVALID);
-    print_message("watertight: %lu traversals at shell corners, edges and faces\n", traced);
-}
-
-/* The step bound is reached by the worst rays and never exceeded: a ray
- * along the main diagonal, slightly off, through an empty tree with one
- * voxel in the far corner, walks about 3 * 2^L voxels at K = 0. */
-static void test_step_bound(void **state)
-{
-    (void)state;
-    for (unsigned levels = 1; levels <= 12; levels++) {
-        const uint32_t lim = UINT32_C(1) << levels;
-        const uint32_t far[1][3] = {{lim - 1, lim - 1, lim - 1}};
-        oct_tree *t = tree_util_simple(levels, far, 1);
-        assert_non_null(t);
-        /* d = (1, 1 - e, 1 - 2e): crosses each axis' planes at distinct times */
-        const double eye[3] = {0, 0, 0}, dir[3] = {1, 1 - 0x1p-30, 1 - 0x1p-29};
-        trace_opts o = {0, 0};
-        trace_hit h;
-        assert_int_equal(trace_ray_cast(t, &o, eye, dir, &h), 1);
-        assert_true(h.steps <= trace_max_steps(levels));
-        assert_int_equal(h.steps, 3 * (lim - 1)); /* every plane crossed separately */
-        /* exactly diagonal: one step per voxel */
-        const double diag[3] = {1, 1, 1};
-        assert_int_equal(trace_ray_cast(t, &o, eye, diag, &h), 1);
-        assert_int_equal(h.steps, lim - 1);
-        tree_util_free(t);
-        /* empty tree: returns at once */
-        t = tree_util_simple(levels, NULL, 0);
-        assert_int_equal(trace_ray_cast(t, &o, eye, dir, &h), 0);
-        assert_int_equal(h.steps, 0);
-        tree_util_free(t);
-    }
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_step_bound),
         cmocka_unit_test(test_exact_random_trees),
         cmocka_unit_test(test_exact_deep_trees),
         cmocka_unit_test(test_general_rays_tolerance),
-        cmocka_unit_test(test_watertight_shells),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

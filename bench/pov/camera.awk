@@ -1,4 +1,4 @@
-# camera.awk: our camera (INTERFACE.md) as POV-Ray explicit camera vectors.
+# camera.awk: our camera (docs/INTERFACE.md) as POV-Ray explicit camera vectors.
 # POV-Ray shoots the ray of pixel (i, j) along direction + (x - 1/2) right
 # + (1/2 - y) up with x = (i + 1/2)/W, y = (j + 1/2)/H; given our forward,
 # 2h(W/H) right and 2h up' as those vectors it is exactly our ray, and no

@@ -1,4 +1,4 @@
-/* scene: reader for .scene files (bounds, surface, color; INTERFACE.md),
+/* scene: reader for .scene files (bounds, surface, color; docs/INTERFACE.md),
  * each surface expression compiled to a tape. */
 #ifndef SCENE_H
 #define SCENE_H

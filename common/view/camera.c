@@ -1,5 +1,7 @@
-/* camera: the pinhole camera of INTERFACE.md. */
+/* camera: the pinhole camera of docs/INTERFACE.md. */
 #include "common/view/camera.h"
+
+#include "common/limits.h"
 
 #include <math.h>
 
@@ -11,7 +13,7 @@ const char *camera_strerror(camera_err e)
     case CAMERA_ESAME: return "eye and target are the same point";
     case CAMERA_EPARALLEL: return "up is parallel to the view direction";
     case CAMERA_EFOV: return "fov must be in (0, 180) degrees";
-    case CAMERA_ESIZE: return "image size must be 1..32768 pixels a side";
+    case CAMERA_ESIZE: return "image size must be 1.." LIMIT_STR(CAMERA_MAX_SIZE) " pixels a side";
     }
     return "unknown camera error";
 }

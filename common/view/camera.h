@@ -1,4 +1,4 @@
-/* camera: the pinhole camera of INTERFACE.md, pixel centre -> unit ray. */
+/* camera: the pinhole camera of docs/INTERFACE.md, pixel centre -> unit ray. */
 #ifndef CAMERA_H
 #define CAMERA_H
 
@@ -30,7 +30,7 @@ camera_err camera_init(camera *c, const double eye[3], const double target[3], c
                        double fov_deg, long width, long height);
 
 /* Unit direction through the centre of pixel (i, j), i left to right, j top
- * to bottom, exactly as INTERFACE.md writes it. */
+ * to bottom, exactly as docs/INTERFACE.md writes it. */
 void camera_ray(const camera *c, uint32_t i, uint32_t j, double dir[3]);
 
 /* camera_ray in pieces, for renderers that reuse u along a column and v

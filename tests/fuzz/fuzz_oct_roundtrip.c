@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "format/oct.h"
-#include "tests/oct_testutil.h"
+#include "bench/oct_synth.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

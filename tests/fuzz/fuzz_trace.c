@@ -14,7 +14,8 @@
 #include <string.h>
 
 #include "render/trace.h"
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
+#include "tests/trace_oracle.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -96,7 +97,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (unsigned k = 0; k <= levels; k++) {
         trace_opts opts = {k, 0};
         trace_hit h;
-        trace_ray_cast(t, &opts, o, d, &h); /* unit cells: world = grid */
+        trace_cast_all(t, &opts, o, d, &h); /* unit cells: world = grid */
         int good = h.steps <= trace_max_steps(levels);
         if (best < 0)
             good = good && !h.hit;

@@ -1,5 +1,5 @@
 /* tree_util: in-memory oct_tree builder for tests and benchmarks. */
-#include "tests/tree_util.h"
+#include "bench/tree_util.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,8 +1,8 @@
-/* oct_testutil: random sparse voxel trees for the .oct tests and the fuzz
- * corpus generator: Morton-sorted voxels, their masks per depth, and the
- * bytes the writer makes of them. */
-#ifndef OCT_TESTUTIL_H
-#define OCT_TESTUTIL_H
+/* oct_synth: random sparse voxel trees for the .oct tests, the fuzz corpus
+ * generator and the validation benchmark: Morton-sorted voxels, their masks
+ * per depth, and the bytes the writer makes of them. */
+#ifndef OCT_SYNTH_H
+#define OCT_SYNTH_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -34,13 +34,17 @@ void test_tree_free(test_tree *t);
 /* Writes the tree through the streaming writer (depths fed in random-size
  * chunks, deepest first) into a malloc'd buffer. Returns the writer's error. */
 oct_err test_tree_write(const test_tree *t, unsigned char **buf, size_t *len);
+/* The same with v11's format 1.1 fields (flags, shard fields, function;
+ * everything else comes from t). */
+oct_err test_tree_write_1_1(const test_tree *t, const oct_writer_params *v11, unsigned char **buf,
+                            size_t *len);
 
 /* Recomputes the header's section CRCs and the header CRC after a test has
  * edited a file, so that a check other than the CRC's is exercised. Uses the
  * header's own offsets and skips any section outside the buffer. */
 void test_oct_refresh_crcs(unsigned char *buf, size_t len);
 
-/* xorshift64* (tests/rng.h); a zero *state starts from a fixed seed. */
+/* xorshift64* (bench/rng.h); a zero *state starts from a fixed seed. */
 uint64_t test_rand(uint64_t *state);
 
 #endif

@@ -1,0 +1,206 @@
+/* trace_setup: a ray mapped into a tree's grid and clipped to its root cube
+ * (trace_setup, trace_eye_init / trace_setup_eye, trace_clip), and the
+ * anchors a bundle of rays starts from (trace_anchor_find). See trace.h. */
+#include "render/trace.h"
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+
+#include "render/trace_impl.h"
+
+/* trace_anchor's nodes are copied onto the traversal's frames */
+_Static_assert(sizeof(trace_frame) == 16 && offsetof(trace_frame, mask) == 8 &&
+                   offsetof(trace_frame, ci) == 12 && sizeof(((trace_anchor *)0)->node[0]) == 16,
+               "trace_anchor node layout");
+
+uint32_t trace_max_steps(unsigned levels)
+{
+    return 3u * (UINT32_C(1) << levels) + levels;
+}
+
+/* floor(x) clamped to [lo, hi] and converted without overflow. */
+static uint32_t floor_clamp(double x, uint32_t lo, uint32_t hi)
+{
+    double f = floor(x);
+    if (!(f >= (double)lo))
+        return lo;
+    if (f >= (double)hi)
+        return hi;
+    return (uint32_t)f;
+}
+
+int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e)
+{
+    e->ok = 0;
+    if (tree->levels < 1 || tree->levels > OCT_MAX_LEVELS)
+        return 0;
+    e->nvox = UINT32_C(1) << tree->levels;
+    e->n = (double)e->nvox;
+    e->scale = e->n / tree->edge;
+    if (!(e->scale > 0.0 && e->scale <= DBL_MAX)) /* trace_setup_eye relies on it */
+        return 0;
+    for (int a = 0; a < 3; a++) {
+        if (!isfinite(eye[a]))
+            return 0;
+        e->o[a] = (eye[a] - tree->origin[a]) * e->scale;
+        if (!isfinite(e->o[a]))
+            return 0;
+        e->lo[a] = 0.0 - e->o[a];
+        e->hi[a] = e->n - e->o[a];
+        e->inside[a] = !(e->o[a] < 0.0 || e->o[a] > e->n);
+    }
+    e->ok = 1;
+    return 1;
+}
+
+int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
+{
+    if (!e->ok)
+        return 0;
+    const double n = e->n, scale = e->scale;
+    const double *o = e->o;
+    /* scale is finite and > 0, so d is finite exactly when dir is and the
+     * product does not overflow; 1/d is finite exactly when d is neither 0
+     * nor so small that the reciprocal overflows */
+    double d[3];
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++)
+        d[a] = dir[a] * scale;
+    if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
+        return 0;
+    unsigned active = 0;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const double inv = 1.0 / d[a];
+        const int act = fabs(inv) <= DBL_MAX;
+        active |= (unsigned)act << a;
+        r->inv[a] = act ? inv : 1.0;
+        r->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
+        r->d[a] = act ? d[a] : 0.0;
+    }
+    if (!active)
+        return 0;
+    r->active = active;
+
+    /* One slab test against [0, n]^3. No 0 * inf: zero axes are tested by
+     * position only. */
+    double t0 = -INFINITY, t1 = INFINITY;
+    int entry = -1;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        if (!(active >> a & 1)) {
+            if (!e->inside[a])
+                return 0;
+            continue;
+        }
+        double ta = e->lo[a] * r->inv[a], tb = e->hi[a] * r->inv[a];
+        double lo = ta < tb ? ta : tb, hi = ta < tb ? tb : ta;
+        if (lo > t0) {
+            t0 = lo;
+            entry = a;
+        }
+        if (hi < t1)
+            t1 = hi;
+    }
+    if (!(t0 <= t1) || !(t1 > 0.0))
+        return 0;
+
+    /* Re-base a ray from outside to its entry point, so that T() works on
+     * coordinates of the grid's magnitude whatever the eye's distance. */
+    if (t0 > 0.0) {
+        r->t_base = t0;
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++) {
+            double p = o[a];
+            if (a == entry)
+                p = r->sgn[a] > 0 ? 0.0 : n;
+            else if (active >> a & 1)
+                p = o[a] + t0 * r->d[a];
+            r->o[a] = p < 0.0 ? 0.0 : p > n ? n : p;
+        }
+    } else {
+        r->t_base = 0.0;
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++)
+            r->o[a] = o[a];
+    }
+    double t_end = INFINITY;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        r->ot[a] = (active >> a & 1) ? r->o[a] : -INFINITY;
+        if (active >> a & 1) {
+            double te = trace_plane_time(r, a, r->sgn[a] > 0 ? n : 0.0);
+            if (te < t_end)
+                t_end = te;
+        }
+    }
+    if (!(t_end > 0.0))
+        return 0;
+    r->t_start = 0.0;
+    r->t_end = t_end;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        r->v[a] = (active >> a & 1) ? 0u : floor_clamp(r->o[a], 0, e->nvox - 1);
+    }
+    return 1;
+}
+
+int trace_setup(const oct_tree *tree, const double eye[3], const double dir[3], trace_ray *r)
+{
+    trace_eye e;
+    if (!trace_eye_init(tree, eye, &e))
+        return 0;
+    return trace_setup_eye(&e, dir, r);
+}
+
+int trace_clip(trace_ray *r, double t_lo, double t_hi)
+{
+    const double lo = t_lo - r->t_base, hi = t_hi - r->t_base;
+    if (lo > r->t_start)
+        r->t_start = lo;
+    if (hi < r->t_end)
+        r->t_end = hi;
+    return r->t_start < r->t_end;
+}
+
+void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
+                       trace_anchor *a)
+{
+    const unsigned levels = tree->levels;
+    a->depth = 0;
+    a->cell[0] = a->cell[1] = a->cell[2] = 0;
+    if (tree->node_count[0] == 0 || levels < 1 || levels > OCT_MAX_LEVELS)
+        return; /* an empty tree: nothing to anchor */
+    a->node[0].prefix = tree->groups[0][0].base;
+    a->node[0].mask = tree->groups[0][0].mask[0];
+    a->node[0].ci = 0;
+    const double n = (double)(UINT32_C(1) << levels);
+    for (int i = 0; i < 3; i++)
+        if (!(lo[i] > 0.0 && hi[i] < n && lo[i] <= hi[i])) /* NaN too */
+            return;
+    /* whole voxels: the box lies in voxels [vl, vh] */
+    uint32_t vl[3], vh[3];
+    for (int i = 0; i < 3; i++) {
+        vl[i] = (uint32_t)lo[i];
+        vh[i] = (uint32_t)hi[i];
+    }
+    for (unsigned d = 1; d < levels; d++) {
+        const unsigned sh = levels - d;
+        if ((vl[0] >> sh) != (vh[0] >> sh) || (vl[1] >> sh) != (vh[1] >> sh) ||
+            (vl[2] >> sh) != (vh[2] >> sh))
+            return; /* the box straddles two cells of depth d */
+        const unsigned c = (vl[0] >> sh & 1u) | (vl[1] >> sh & 1u) << 1 | (vl[2] >> sh & 1u) << 2;
+        const uint32_t m = a->node[d - 1].mask;
+        if (!(m >> c & 1u))
+            return; /* an empty cell: its parent is the deepest occupied one */
+        const uint64_t idx = a->node[d - 1].prefix + oct_popcount64(m & ((1u << c) - 1u));
+        const oct_children ch = oct_node_children(tree->groups[d], idx);
+        a->node[d].mask = ch.mask;
+        a->node[d].prefix = ch.first;
+        a->node[d].ci = c;
+        a->depth = d;
+        for (int i = 0; i < 3; i++)
+            a->cell[i] = vl[i] >> sh << sh;
+    }
+}
