@@ -17,7 +17,6 @@
 
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
-#include "tests/rng.h"
 #include "tests/test_tape_util.h"
 
 /* ---- the scenes in plain C ---------------------------------------------- */
