@@ -58,7 +58,7 @@ static void build_with(const scene *sc, const build_params *bp, built *b)
 static void build_in_memory(const scene *sc, unsigned levels, build_method method, unsigned threads,
                             built *b)
 {
-    build_params bp = {levels, method, threads, NULL, NULL, 0};
+    build_params bp = {.levels = levels, .method = method, .threads = threads};
     build_with(sc, &bp, b);
 }
 
@@ -227,7 +227,8 @@ static void test_shell_only_same_voxels(void **state)
     for (size_t k = 0; k < sizeof paths / sizeof *paths; k++)
         for (unsigned levels = 6; levels <= (SANITIZED ? 6u : 8u); levels += 2) {
             scene *sc = load(paths[k]);
-            build_params full = {levels, BUILD_INTERVAL, 2, NULL, NULL, 0}, shell = full;
+            build_params full = {.levels = levels, .method = BUILD_INTERVAL, .threads = 2};
+            build_params shell = full;
             shell.shell_only = 1;
             built a, b;
             build_with(sc, &full, &a);
