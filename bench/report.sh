@@ -49,6 +49,22 @@ while read -r s ts bs; do
     lv=$(awk -F, -v s="$s" 'NR > 1 && $6 == s { printf "%s%s", sep, $7; sep = " " }' "$RES/rasterize.csv")
     echo "| $s | $lv | $ts | $bs |"
 done
+if [ -f "$RES/rastspeed.csv" ] && [ "$(wc -l <"$RES/rastspeed.csv")" -gt 1 ]; then
+    echo
+    echo "Rasterize speed, one run each: M voxels kept a second (wall time with start-up) and CPU use"
+    echo "(user + system over wall: 200 % keeps both cores busy); the shell: voxels kept over the voxels"
+    echo "the surface really passes through (\`bench/shellratio\`: a sign change on a 5³ lattice per voxel),"
+    echo "and the stored records against the exact surface (\`bench/normalerr\`: normal against the gradient"
+    echo "at the foot point of the voxel centre, plane offset against the distance to it):"
+    echo
+    echo "| scene | levels | seconds | voxels | M voxels/s | CPU % |"
+    echo "|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { printf "| %s | %d | %.2f | %d | %.2f | %s |\n", $6, $7, $8, $9, $10, $11 }' "$RES/rastspeed.csv"
+    echo
+    echo "| scene | levels | kept | real | kept / real | real ones lost | normal err mean / p99 ° | offset err mean / p99 voxel |"
+    echo "|---|---|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { printf "| %s | %d | %d | %d | %.3f | %d | %.3f / %.3f | %.4f / %.4f |\n", $6, $7, $8, $9, $10, $11, $14, $15, $17, $18 }' "$RES/shell.csv"
+fi
 if [ "$(wc -l <"$RES/povray.csv")" -gt 1 ]; then
     echo
     echo "The peer, POV-Ray 3.7 \`isosurface\` (max_gradient = 1.5 x the largest |grad f| sampled on a 96³ grid),"
@@ -73,7 +89,7 @@ for p in error_vs_time p99_vs_time rasterize_time rasterize_bytes shard_scale; d
     [ -f "$RES/$p.png" ] && echo "![$p]($RES/$p.png)"
 done
 echo
-echo "CSV files: \`$RES/\` (rasterize, render, refcast, figure4, povray, shard, shard_scale)."
+echo "CSV files: \`$RES/\` (rasterize, rastspeed, shell, render, refcast, figure4, povray, shard, shard_scale)."
 echo "<!-- bench:end -->"
 } >"$T.new"
 if grep -q '<!-- bench:begin -->' "$README"; then

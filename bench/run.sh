@@ -15,19 +15,23 @@ quick) # manyblobs' reference alone would take a minute
     SCENES=${SCENES:-"blobs_a blobs_b thin csg"}
     LEVELS=${LEVELS:-"6 8"}; LEVELS_BLOBS=${LEVELS_BLOBS:-"6 7 8"}
     SIZE=${SIZE:-512}; NVIEWS=${NVIEWS:-1}; REPS=${REPS:-3}; RAST_REPS=${RAST_REPS:-1}
-    FIG_LEVELS=${FIG_LEVELS:-8}; FIG_SIZES=${FIG_SIZES:-"256 512"}; POV_SIZE=${POV_SIZE:-256} ;;
+    FIG_LEVELS=${FIG_LEVELS:-8}; FIG_SIZES=${FIG_SIZES:-"256 512"}; POV_SIZE=${POV_SIZE:-256}
+    SPEED_SCENES=${SPEED_SCENES:-"blobs_a csg"}; SPEED_LEVELS=${SPEED_LEVELS:-8}
+    SHELL_LEVELS=${SHELL_LEVELS:-7} ;;
 full)
     SCENES=${SCENES:-"blobs_a blobs_b thin csg manyblobs"}
     LEVELS=${LEVELS:-"6 7 8 9 10"}; LEVELS_BLOBS=${LEVELS_BLOBS:-"6 7 8 9 10 11 12"}
     SIZE=${SIZE:-1024}; NVIEWS=${NVIEWS:-3}; REPS=${REPS:-3}; RAST_REPS=${RAST_REPS:-3}
     FIG_LEVELS=${FIG_LEVELS:-10}; FIG_SIZES=${FIG_SIZES:-"256 512 1024"}
-    POV_SIZE=${POV_SIZE:-1024} ;;
+    POV_SIZE=${POV_SIZE:-1024}
+    SPEED_SCENES=${SPEED_SCENES:-"blobs_a blobs_b csg gyroid manyblobs"}
+    SPEED_LEVELS=${SPEED_LEVELS:-"10 12"}; SHELL_LEVELS=${SHELL_LEVELS:-9} ;;
 *)
     echo "usage: bench/run.sh quick|full" >&2; exit 2 ;;
 esac
 D=$(dirname "$0")
 for t in "$BIN/rasterize" "$BIN/render" "$TOOLS/refcast" "$TOOLS/imgcompare" "$TOOLS/gradmax" \
-         "$TOOLS/scene2pov"; do
+         "$TOOLS/scene2pov" "$TOOLS/shellratio" "$TOOLS/normalerr"; do
     [ -x "$t" ] || { echo "bench: $t missing: run 'make all tools' first" >&2; exit 1; }
 done
 sh "$D/deps.sh" "$MODE"
@@ -147,6 +151,41 @@ for s in $SCENES; do
         render_views "$oct" "$s" "$L" plain
         render_views "$oct" "$s" "$L" refine
         case $s.$L in blobs_a.$FIG_LEVELS|blobs_b.$FIG_LEVELS) ;; *) rm -f "$oct" ;; esac
+    done
+done
+
+# ---- rasterize speed: M voxels kept a second and CPU use (user + system over
+# wall, 200 % = both cores busy to the end), one run each; the shell: voxels
+# kept over the voxels the surface really passes through (bench/shellratio) ----
+SPEED="$RES/rastspeed.csv" SHELL="$RES/shell.csv"
+echo "$PROVH,scene,levels,seconds,voxels,mvox_s,cpu_pct" >"$SPEED"
+echo "$PROVH,scene,levels,kept,real,ratio,lost,voxels_near,voxels_missed,normal_mean_deg,normal_p99_deg,normal_max_deg,offset_mean_vox,offset_p99_vox,offset_max_vox" >"$SHELL"
+for s in $SPEED_SCENES; do
+    for L in $SPEED_LEVELS; do
+        o="$WORK/speed.oct"
+        if [ -x /usr/bin/time ]; then
+            /usr/bin/time -f "time %e %U %S" "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" \
+                >"$WORK/rlog" 2>&1
+            set -- $(sed -n 's/^time \([0-9.]*\) \([0-9.]*\) \([0-9.]*\)$/\1 \2 \3/p' "$WORK/rlog")
+            sec=$1 cpu=$(awk -v w="$1" -v u="$2" -v k="$3" 'BEGIN { printf "%.0f", 100 * (u + k) / w }')
+        else
+            "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" >"$WORK/rlog" 2>&1
+            sec=$(sed -n 's/.*; \([0-9.]*\) s, peak memory.*/\1/p' "$WORK/rlog") cpu=nan
+        fi
+        rm -f "$o"
+        v=$(sed -n 's/.* \([0-9]*\) voxels, [0-9]* nodes.*/\1/p' "$WORK/rlog")
+        mv=$(awk -v v="$v" -v t="$sec" 'BEGIN { printf "%.2f", v / t / 1e6 }')
+        echo "$PROV,$s,$L,$sec,$v,$mv,$cpu" >>"$SPEED"
+        echo "  rasterize speed $s levels $L: $sec s, $v voxels, $mv M voxels/s, CPU $cpu %"
+    done
+    for L in $SHELL_LEVELS; do
+        o="$WORK/shell.oct"
+        "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" -q
+        r=$("$TOOLS/shellratio" "scenes/$s.scene" "$o" --csv) || echo "bench: $s levels $L: shellratio failed" >&2
+        ne=$("$TOOLS/normalerr" "scenes/$s.scene" "$o" --csv)
+        rm -f "$o"
+        echo "$PROV,$s,$L,$r,$ne" >>"$SHELL"
+        echo "  shell $s levels $L: kept,real,ratio,lost = $r; records against the exact surface: $ne"
     done
 done
 

@@ -110,6 +110,17 @@ typedef struct task_out {
     int done;
 } task_out;
 
+/* 1 when t has an abs, min or max: a kink, where the gradient enclosure
+ * spans both branches and the mean-value form is loose, so the plain
+ * interval test may still drop a voxel the form keeps. */
+static inline uint8_t tape_has_kink(const tape *t)
+{
+    for (uint32_t i = 0; i < t->n; i++)
+        if (t->insn[i].op == TAPE_ABS || t->insn[i].op == TAPE_MIN || t->insn[i].op == TAPE_MAX)
+            return 1;
+    return 0;
+}
+
 /* --- per-thread state --------------------------------------------------- */
 
 typedef struct worker {
@@ -123,12 +134,17 @@ typedef struct worker {
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
     tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
     uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
+    uint8_t *kinked;       /* [(levels + 2) * nsurf]: the cell's tape of that surface has a kink */
     unsigned *nact;        /* [levels + 2] */
     interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
     double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */
     uint8_t *cf_ok;        /* [nsurf]: cf holds them for that surface (voxel_surface clears) */
     double *cf8;           /* [nsurf * 8 * 4]: the same for the 8 children of a leaf-parent */
+    uint8_t *cf8_have;     /* [nsurf]: the children whose cf8 entries are set, 0 on a tape with
+                              a kink (their differences do not estimate second derivatives) */
     uint8_t *grad_ok;      /* [(levels + 2) * nsurf]: that enclosure is valid */
+    interval *fcen;        /* [(levels + 2) * nsurf]: with it, f's enclosure at the form's centre */
+    double (*ncen)[3];     /* [levels + 2]: the node's centre, the form's */
     task_out *out;
     build_stats st;
     int failed;
@@ -160,11 +176,13 @@ int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
                                const interval box[3], const double centre[3], double fd);
 
 /* The mean-value enclosures of the eight children of the node (depth, cell)
- * with box pbox and centre pc, into out; G receives (or, with reuse_G,
- * holds) the gradient enclosure over the node. 0 when unavailable. */
-int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
-                     unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
-                     interval out[8]);
+ * with box pbox, into out, the form centred on fcc. Without reuse, G and fc
+ * receive the gradient enclosure over the node and f's enclosure at fcc, the
+ * node's centre; with reuse they hold those of a box holding the node (its
+ * parent's), centred on fcc. 0 when unavailable. */
+int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned depth,
+                     const uint64_t cell[3], const double fcc[3], interval *fc, interval G[3],
+                     int reuse, interval out[8]);
 
 /* --- voxels (voxel_normal.c) -------------------------------------------- */
 
@@ -207,9 +225,11 @@ unsigned shell_surface(worker *wk, unsigned idx, const double centre[3]);
 int emit_voxel(worker *wk, const interval box[3], const double centre[3]);
 
 /* The records of a leaf-parent's np voxels (children child[j], surfaces
- * surf[j], iterations started in nw[j]), appended in child order: the
- * Newton steps of all of them that still move are evaluated together, one
- * pass over the tape per round (tape_eval_grad_lanes). */
+ * surf[j], iterations started in nw[j]), appended in child order. Where the
+ * siblings' centre gradients (wk->cf8) give a Hessian, one Newton step on the
+ * second-order model about the centre; elsewhere the Newton steps of all of
+ * them that still move are evaluated together, one pass over the tape per
+ * round (tape_eval_grad_lanes). */
 void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child, const uint8_t *surf,
                  newton *nw, unsigned np);
 

@@ -152,36 +152,41 @@ unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const ui
             tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
             tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
                              wk->scratch, child);
+            wk->kinked[(size_t)idx * ns + s] = tape_has_kink(child);
         } else {
             *child = *t;
+            wk->kinked[(size_t)idx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
         }
     }
     wk->nact[idx] = n;
     return n;
 }
 
-/* The mean-value enclosures of a node's eight children. With c the node's
- * centre, fc an enclosure of f(c) and G one of the gradient over the node,
- * every point p of child i satisfies f(p) in fc + sum_k G_k (p_k - c_k), and
- * p_k - c_k lies in the lower or upper half-offset of axis k according to
- * bit k of i. The six products are formed once, so a child costs three
+/* The mean-value enclosures of a node's eight children. With c the form's
+ * centre, fc an enclosure of f(c) and G one of the gradient over a box that
+ * holds c and the node, every point p of child i satisfies f(p) in
+ * fc + sum_k G_k (p_k - c_k), and p_k - c_k lies in the lower or upper
+ * half-offset of axis k according to bit k of i. A leaf-parent takes its
+ * parent's form (reuse): offsets up to twice as long make it wider by about
+ * the width of G times a voxel, a percent or two of it, for no evaluation. The six products are formed once, so a child costs three
  * interval additions and no tape evaluation. The form's excess width shrinks
  * with the square of the cell size, so on the finest levels it is tighter
  * than the plain interval as well as cheaper. Returns 0 when G or f(c) may be
  * undefined (then the caller tests the children one by one). */
-int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const double pc[3],
-                     unsigned depth, const uint64_t cell[3], interval G[3], int reuse_G,
-                     interval out[8])
+int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned depth,
+                     const uint64_t cell[3], const double fcc[3], interval *fc, interval G[3],
+                     int reuse, interval out[8])
 {
     const build_ctx *c = wk->c;
-    interval fc, half[3][2];
+    interval half[3][2];
     unsigned fl = 0;
-    if (!reuse_G) {
+    if (!reuse) {
         tape_eval_interval_grad(t, pbox, G, wk->islots, &fl);
         wk->st.gradient_evals++;
+        if (fl || !eval_at_centre(wk, t, fcc, fc))
+            return 0;
     }
-    if (fl || !eval_at_centre(wk, t, pc, &fc))
-        return 0;
+    const double *pc = fcc;
     for (int k = 0; k < 3; k++) {
         /* The children's shared face, rounded as cell_box rounds it. */
         double m = c->origin[k] + (double)(2 * cell[k] + 1) * c->cell_edge[depth + 1];
@@ -195,7 +200,7 @@ int child_enclosures(worker *wk, const tape *t, const interval pbox[3], const do
      * (2 + 4 + 8 additions instead of 3 x 8, the same values). */
     interval s1[2], s2[4];
     for (unsigned i = 0; i < 2; i++)
-        s1[i] = interval_add(fc, half[0][i], &fl);
+        s1[i] = interval_add(*fc, half[0][i], &fl);
     for (unsigned i = 0; i < 4; i++)
         s2[i] = interval_add(s1[i & 1], half[1][i >> 1], &fl);
     for (unsigned i = 0; i < 8; i++)

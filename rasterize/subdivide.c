@@ -25,9 +25,10 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
     for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
+        wk->cf8_have[s] = 0;
         if (!ok[k])
             continue;
-        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
         double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
         for (unsigned i = 0; i < 8; i++) {
             if (T[k][i].lo > 0.0 || T[k][i].hi < 0.0 || !child_box(cb, i))
@@ -47,8 +48,39 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
             fg[1] = g[0][l];
             fg[2] = g[1][l];
             fg[3] = g[2][l];
+            wk->cf8_have[s] |= (uint8_t)(1u << lane[l]);
         }
+        if (wk->kinked[(size_t)pidx * ns + s])
+            wk->cf8_have[s] = 0;
     }
+}
+
+/* Whether the tests a child of the node (depth) faces after the node's
+ * mean-value form (ok: that form was available for surface s) drop it.
+ * Without the form, or on coarse cells, the plain interval test. At the
+ * voxels, the form centred on the voxel, then on a tape with a kink the
+ * plain interval test too: there the gradient enclosure spans both branches
+ * and the forms are loose where the interval is not (csg, gyroid). */
+static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const interval box[3],
+                         const double centre[3])
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1;
+    const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+    if (!ok || depth + 1 < MEAN_VALUE_ALONE_DEPTH) {
+        if (cell_may_cross(wk, t, s, depth + 1, box, centre))
+            return 0;
+        wk->st.taylor_drops += (unsigned)ok;
+        return 1;
+    }
+    if (depth + 1 < c->levels)
+        return 0;
+    if (centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], box, centre,
+                                   centre_fg(wk, s, centre)[0])) {
+        wk->st.taylor_drops++;
+        return 1;
+    }
+    return wk->kinked[(size_t)pidx * ns + s] && !cell_may_cross(wk, t, s, depth + 1, box, centre);
 }
 
 /* The finest levels: children are tested with child_enclosures, inheriting
@@ -63,17 +95,21 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     double pc[3];
     uint8_t ok[OCT_MAX_SURFACES], mask = 0;
     cell_box(c, depth, cell, pbox, pc);
+    memcpy(wk->ncen[pidx], pc, sizeof pc);
     /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
      * holds its own, one evaluation fewer for a slightly wider form. */
     int reuse = depth + 1 == c->levels; /* its parent ran here too: MEAN_VALUE_LEVELS >= 2 */
     for (unsigned k = 0; k < wk->nact[pidx]; k++) {
         unsigned s = wk->act[(size_t)pidx * ns + k];
         interval *G = &wk->grad[((size_t)pidx * ns + s) * 3];
-        if (reuse && wk->grad_ok[(size_t)depth * ns + s])
+        interval *fc = &wk->fcen[(size_t)pidx * ns + s];
+        int r = reuse && wk->grad_ok[(size_t)depth * ns + s];
+        if (r) {
             memcpy(G, &wk->grad[((size_t)depth * ns + s) * 3], 3 * sizeof *G);
-        ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, pc, depth,
-                                          cell, G, reuse && wk->grad_ok[(size_t)depth * ns + s],
-                                          T[k]);
+            *fc = wk->fcen[(size_t)depth * ns + s];
+        }
+        ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, depth, cell,
+                                          r ? wk->ncen[depth] : pc, fc, G, r, T[k]);
         wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
     child_boxes cb; /* most children fall to T alone: boxes are made lazily */
@@ -101,17 +137,13 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                 memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
                 wk->cf_ok[s] = 1;
             }
-            if (!ok[k] || depth + 1 < MEAN_VALUE_ALONE_DEPTH
-                    ? !cell_may_cross(wk, t, s, depth + 1, box, centre)
-                    : depth + 1 == c->levels &&
-                          centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3],
-                                                     box, centre, centre_fg(wk, s, centre)[0])) {
-                wk->st.taylor_drops += ok[k];
+            if (child_dropped(wk, depth, s, ok[k], box, centre)) {
                 wk->cf_ok[s] = 0;
                 continue;
             }
             wk->act[(size_t)cidx * ns + n++] = (uint8_t)s;
             wk->tapes[(size_t)cidx * ns + s] = *t;
+            wk->kinked[(size_t)cidx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
         }
         wk->nact[cidx] = n;
         if (!n)

@@ -1,6 +1,8 @@
 /* voxel_normal: a voxel's record. The surface it belongs to, guarded Newton
- * steps from its centre onto f = 0, and the normal and plane offset packed
- * from where they stop (format/oct_normal.h). */
+ * steps from its centre onto f = 0 (at a leaf-parent, where its siblings'
+ * gradients give second derivatives, one step on the second-order model
+ * instead), and the normal and plane offset packed from where they stop
+ * (format/oct_normal.h). */
 #include <math.h>
 
 #include "format/oct_normal.h"
@@ -32,22 +34,33 @@ static void newton_start(newton *nw, const double centre[3], const double fg_cen
     nw->step = 0;
 }
 
-/* With f and its gradient at the iterate known: 1 when the iterate moved
- * and they are wanted at the new one, 0 when the iteration has stopped. */
-static int newton_advance(newton *nw, const interval box[3], double h)
+/* The Newton step from the iterate, kept inside the voxel, into q; how far
+ * it moves (max norm). -1 when it cannot be taken. */
+static double newton_target(const newton *nw, const interval box[3], double q[3])
 {
-    double f = nw->f, *g = nw->g, *p = nw->p;
+    const double f = nw->f, *g = nw->g, *p = nw->p;
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    if (nw->step == NEWTON_STEPS || !(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
-        return 0;
-    double q[3], moved = 0.0;
+    if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
+        return -1.0;
+    double moved = 0.0;
     for (int k = 0; k < 3; k++) {
         q[k] = min2(max2(p[k] - f / g2 * g[k], box[k].lo), box[k].hi); /* NaN gives lo */
         moved = max2(moved, fabs(q[k] - p[k]));
     }
+    return moved;
+}
+
+/* With f and its gradient at the iterate known: 1 when the iterate moved
+ * and they are wanted at the new one, 0 when the iteration has stopped. */
+static int newton_advance(newton *nw, const interval box[3], double h)
+{
+    double q[3];
+    if (nw->step == NEWTON_STEPS)
+        return 0;
+    double moved = newton_target(nw, box, q);
     if (moved < NEWTON_TOL * h)
-        return 0; /* the linearisation at p places the surface well enough */
-    memcpy(p, q, sizeof q);
+        return 0; /* the linearisation at p places the surface well enough (or no step) */
+    memcpy(nw->p, q, sizeof q);
     nw->step++;
     return 1;
 }
@@ -150,6 +163,62 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
     return push_voxel(wk, newton_record(wk, &nw, centre, h), best);
 }
 
+/* A finite-difference Hessian of surface s over a leaf-parent, shared by
+ * its voxels, from the gradients at its children's centres (wk->cf8, the
+ * children set in wk->cf8_have): column k the mean of the differences over
+ * the pairs of children that differ in bit k alone, then symmetrised. 0 when
+ * an axis has no such pair or a value is not finite. */
+static int leaf_hessian(const worker *wk, unsigned s, const child_boxes *cb, double H[3][3])
+{
+    const double *fg = wk->cf8 + (size_t)s * 32;
+    const unsigned have = wk->cf8_have[s];
+    double D[3][3];
+    for (unsigned k = 0; k < 3; k++) {
+        const unsigned bk = 1u << k;
+        unsigned pairs = 0;
+        D[0][k] = D[1][k] = D[2][k] = 0.0;
+        for (unsigned a = 0; a < 8; a++) {
+            const unsigned b = a | bk;
+            if ((a & bk) || !((have >> a) & (have >> b) & 1u))
+                continue;
+            const double dx = cb->centre[b][k] - cb->centre[a][k];
+            for (unsigned r = 0; r < 3; r++)
+                D[r][k] += (fg[4 * b + 1 + r] - fg[4 * a + 1 + r]) / dx;
+            pairs++;
+        }
+        if (!pairs)
+            return 0;
+        for (unsigned r = 0; r < 3; r++)
+            D[r][k] /= (double)pairs;
+    }
+    for (unsigned r = 0; r < 3; r++)
+        for (unsigned k = 0; k < 3; k++) {
+            H[r][k] = 0.5 * (D[r][k] + D[k][r]);
+            if (!isfinite(H[r][k]))
+                return 0;
+        }
+    return 1;
+}
+
+/* The second-order model about the centre c (f, grad f and H there) at the
+ * iterate p of the first Newton step: f(p) and grad f(p) without evaluating
+ * them. Over a voxel the model's error is third order in its size, below what
+ * more Newton steps would correct (docs/perf-log.md, rasterize). */
+static void model_at_iterate(newton *nw, const double c[3], const double H[3][3])
+{
+    double d[3], Hd[3], f = nw->fg[0];
+    for (int k = 0; k < 3; k++)
+        d[k] = nw->p[k] - c[k];
+    for (int r = 0; r < 3; r++) {
+        Hd[r] = H[r][0] * d[0] + H[r][1] * d[1] + H[r][2] * d[2];
+        f += nw->fg[1 + r] * d[r];
+    }
+    f += 0.5 * (d[0] * Hd[0] + d[1] * Hd[1] + d[2] * Hd[2]);
+    nw->f = f;
+    for (int r = 0; r < 3; r++)
+        nw->g[r] = nw->fg[1 + r] + Hd[r];
+}
+
 void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
                  const uint8_t *surf, newton *nw, unsigned np)
 {
@@ -161,8 +230,26 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
             push_voxel(wk, 0, surf[j]);
         return;
     }
-    for (unsigned j = 0; j < np; j++)
-        live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
+    double H[3][3];
+    int hs = -1, have_h = 0; /* the surface H was made for, and whether it could be */
+    for (unsigned j = 0; j < np; j++) {
+        if ((int)surf[j] != hs) {
+            hs = surf[j];
+            have_h = leaf_hessian(wk, surf[j], cb, H);
+        }
+        if (!have_h) {
+            live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
+            continue;
+        }
+        /* the first step, however short, then the model: no evaluation */
+        double q[3];
+        if (newton_target(&nw[j], cb->box[child[j]], q) >= 0.0) {
+            memcpy(nw[j].p, q, sizeof q);
+            nw[j].step++;
+        }
+        model_at_iterate(&nw[j], cb->centre[child[j]], H);
+        live[j] = 0;
+    }
     for (;;) {
         unsigned first = 0;
         while (first < np && !live[first])

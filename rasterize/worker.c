@@ -15,20 +15,25 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->prune_konst = malloc(depths * c->konst_total * sizeof *wk->prune_konst);
     wk->tapes = calloc(depths * c->nsurf, sizeof *wk->tapes);
     wk->act = calloc(depths * c->nsurf, 1);
+    wk->kinked = calloc(depths * c->nsurf, 1);
     wk->nact = calloc(depths, sizeof *wk->nact);
     wk->grad = calloc(depths * c->nsurf * 3, sizeof *wk->grad);
     wk->grad_ok = calloc(depths * c->nsurf, 1);
+    wk->fcen = calloc(depths * c->nsurf, sizeof *wk->fcen);
+    wk->ncen = calloc(depths, sizeof *wk->ncen);
     wk->cf = malloc((size_t)c->nsurf * 4 * sizeof *wk->cf);
     wk->cf_ok = calloc(c->nsurf, 1);
     wk->cf8 = malloc((size_t)c->nsurf * 32 * sizeof *wk->cf8);
+    wk->cf8_have = calloc(c->nsurf, 1);
     wk->lslots = malloc(len * sizeof *wk->lslots);
     if (!wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
-        !wk->prune || !wk->prune_konst || !wk->tapes || !wk->act || !wk->nact || !wk->grad ||
-        !wk->grad_ok || !wk->cf || !wk->cf_ok || !wk->cf8)
+        !wk->prune || !wk->prune_konst || !wk->tapes || !wk->act || !wk->kinked || !wk->nact || !wk->grad ||
+        !wk->grad_ok || !wk->fcen || !wk->ncen || !wk->cf || !wk->cf_ok || !wk->cf8 || !wk->cf8_have)
         return -1;
     for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
         wk->tapes[s] = *c->full[s];
         wk->act[s] = (uint8_t)s;
+        wk->kinked[s] = tape_has_kink(c->full[s]);
     }
     wk->nact[0] = c->nsurf;
     return 0;
@@ -37,8 +42,8 @@ int worker_init(worker *wk, const build_ctx *c)
 void worker_free(worker *wk)
 {
     free(wk->slots); free(wk->slots2); free(wk->islots); free(wk->dslots);
-    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act);
+    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act); free(wk->kinked);
     free(wk->nact);
-    free(wk->grad); free(wk->grad_ok);
-    free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->lslots);
+    free(wk->grad); free(wk->grad_ok); free(wk->fcen); free(wk->ncen);
+    free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->cf8_have); free(wk->lslots);
 }

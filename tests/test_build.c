@@ -33,17 +33,15 @@ typedef struct built {
     build_stats st;
 } built;
 
-static void build_in_memory(const scene *sc, unsigned levels, build_method method, unsigned threads,
-                            built *b)
+static void build_with(const scene *sc, const build_params *bp, built *b)
 {
     memset(b, 0, sizeof *b);
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
-    build_writer_params(sc, levels, palette, &wp);
+    build_writer_params(sc, bp->levels, palette, &wp);
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {.levels = levels, .method = method, .threads = threads};
-    assert_int_equal(build_octree(sc, &bp, w, &b->st), OCT_OK);
+    assert_int_equal(build_octree(sc, bp, w, &b->st), OCT_OK);
     FILE *mem = open_memstream(&b->bytes, &b->size);
     assert_non_null(mem);
     uint64_t n = 0;
@@ -55,6 +53,13 @@ static void build_in_memory(const scene *sc, unsigned levels, build_method metho
     assert_int_equal(oct_open_memory(b->bytes, b->size, 0, &b->file, &off), OCT_OK);
     b->tree = oct_get_tree(b->file);
     assert_int_equal(b->tree->voxel_count, b->st.voxels);
+}
+
+static void build_in_memory(const scene *sc, unsigned levels, build_method method, unsigned threads,
+                            built *b)
+{
+    build_params bp = {.levels = levels, .method = method, .threads = threads};
+    build_with(sc, &bp, b);
 }
 
 static void built_free(built *b)
@@ -193,16 +198,58 @@ static void test_lipschitz_method_loses_nothing(void **state)
 static void test_output_independent_of_threads(void **state)
 {
     (void)state;
-    scene *sc = load("scenes/blobs_b.scene");
-    built one, two;
-    unsigned levels = SANITIZED ? 5 : 7;
-    build_in_memory(sc, levels, BUILD_INTERVAL, 1, &one);
-    build_in_memory(sc, levels, BUILD_INTERVAL, 3, &two);
-    assert_int_equal(one.size, two.size);
-    assert_memory_equal(one.bytes, two.bytes, one.size);
-    built_free(&one);
-    built_free(&two);
-    scene_free(sc);
+    /* blobs_b below and at the levels where leaf-parents make their records
+     * together (second-order model), csg where the kinked tapes face the
+     * plain test at the voxels too */
+    static const struct { const char *path; unsigned levels, san_levels; } cases[] = {
+        {"scenes/blobs_b.scene", 7, 5}, {"scenes/blobs_b.scene", 8, 8}, {"scenes/csg.scene", 8, 8}};
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        scene *sc = load(cases[k].path);
+        built one, two;
+        unsigned levels = SANITIZED ? cases[k].san_levels : cases[k].levels;
+        build_in_memory(sc, levels, BUILD_INTERVAL, 1, &one);
+        build_in_memory(sc, levels, BUILD_INTERVAL, 3, &two);
+        assert_int_equal(one.size, two.size);
+        assert_memory_equal(one.bytes, two.bytes, one.size);
+        built_free(&one);
+        built_free(&two);
+        scene_free(sc);
+    }
+}
+
+/* shell_only makes the same voxels (tree and surfaces) as a full build,
+ * every record 0: at levels where the leaf-parents' records are made
+ * together (8) and below (6), on one surface and on several. */
+static void test_shell_only_same_voxels(void **state)
+{
+    (void)state;
+    static const char *paths[] = {"scenes/blobs_b.scene", "scenes/multi.scene", "scenes/csg.scene"};
+    for (size_t k = 0; k < sizeof paths / sizeof *paths; k++)
+        for (unsigned levels = 6; levels <= (SANITIZED ? 6u : 8u); levels += 2) {
+            scene *sc = load(paths[k]);
+            build_params full = {.levels = levels, .method = BUILD_INTERVAL, .threads = 2};
+            build_params shell = full;
+            shell.shell_only = 1;
+            built a, b;
+            build_with(sc, &full, &a);
+            build_with(sc, &shell, &b);
+            const oct_tree *ta = a.tree, *tb = b.tree;
+            assert_int_equal(ta->voxel_count, tb->voxel_count);
+            assert_true(ta->voxel_count > 0);
+            for (unsigned d = 0; d < levels; d++) {
+                assert_int_equal(ta->node_count[d], tb->node_count[d]);
+                assert_memory_equal(ta->groups[d], tb->groups[d],
+                                    (size_t)(ta->node_count[d] + 7) / 8 * sizeof *ta->groups[d]);
+            }
+            if (ta->surfaces)
+                assert_memory_equal(ta->surfaces, tb->surfaces, (size_t)ta->voxel_count);
+            for (uint64_t v = 0; v < tb->voxel_count; v++)
+                assert_int_equal(tb->voxels[v], 0);
+            assert_true(b.st.point_evals < a.st.point_evals);
+            built_free(&a);
+            built_free(&b);
+            scene_free(sc);
+        }
 }
 
 /* Sphere of radius R about C: normals radial, plane offsets the distance from
@@ -259,81 +306,91 @@ static void test_sphere_normals_and_offsets(void **state)
     scene_free(sc);
 }
 
-/* Voxel (x, y, z) of levels L in the cube: its Newton point from the centre
- * on the scene's whole function, as documented (guarded steps, clamped to
- * the voxel, stop below a quarter voxel), then the normal and the offset of
- * the linearised surface along it, in voxel edges. */
-static void reference_record(const tape *t, const double origin[3], double h, const uint64_t v[3],
-                             double n[3], double *offset)
+/* The exact record of the voxel with centre c: Newton's projection of c onto
+ * f = 0 on the whole function, iterated to convergence, gives the foot
+ * point; the normal is the normalised gradient there, the offset the
+ * distance from c to it along the normal, in voxel edges. 0 when the
+ * projection does not settle within half a voxel diagonal of c. */
+static int exact_record(const tape *t, tape_dual *slots, const double c[3], double h, double n[3],
+                        double *offset)
 {
-    tape_dual *slots = malloc(t->n * sizeof *slots);
-    assert_non_null(slots);
-    double c[3], p[3], lo[3], hi[3], g[3], f = 0.0;
-    for (int k = 0; k < 3; k++) {
-        lo[k] = origin[k] + (double)v[k] * h;
-        hi[k] = lo[k] + h;
-        c[k] = p[k] = lo[k] + 0.5 * h;
-    }
-    for (int step = 0; step <= 4; step++) {
-        f = tape_eval_grad(t, p, g, slots);
-        const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if (step == 4 || f == 0.0)
-            break;
-        double q[3], moved = 0.0;
+    double p[3] = {c[0], c[1], c[2]}, g[3];
+    for (int it = 0; it < 30; it++) {
+        double f = tape_eval_grad(t, p, g, slots), g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (!(g2 > 0.0) || !isfinite(f))
+            return 0;
+        double step = 0.0;
         for (int k = 0; k < 3; k++) {
-            q[k] = fmin(fmax(p[k] - f / g2 * g[k], lo[k]), hi[k]);
-            moved = fmax(moved, fabs(q[k] - p[k]));
+            p[k] -= f / g2 * g[k];
+            step += fabs(f / g2 * g[k]);
         }
-        if (moved < 0.25 * h)
+        if (step < 1e-9 * h)
             break;
-        memcpy(p, q, sizeof p);
     }
-    const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2], len = sqrt(g2);
+    tape_eval_grad(t, p, g, slots);
+    double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), dist = 0.0;
     *offset = 0.0;
     for (int k = 0; k < 3; k++) {
         n[k] = g[k] / len;
-        *offset += n[k] * (p[k] - f / g2 * g[k] - c[k]) / h;
+        *offset += n[k] * (p[k] - c[k]) / h;
+        dist += (p[k] - c[k]) * (p[k] - c[k]);
     }
-    *offset = fmin(fmax(*offset, -0.8660254037844386), 0.8660254037844386);
-    free(slots);
+    return sqrt(dist) <= 0.8660254037844386 * h;
 }
 
 /* Per-cell pruning may freeze a far blob's term into a constant while
  * subdividing, which keeps f's value within a thousandth of a voxel's
- * spread but drops that term's gradient: the normals and offsets must come
- * from the whole function. blobs_b, every voxel against the reference. */
+ * spread but drops that term's gradient (normals off by up to 3.5 degrees,
+ * offsets by 0.18 voxel): the records must come from the whole function.
+ * blobs_b at levels 8, where the leaf-parents' records come from the
+ * second-order model, every voxel (every 7th under the sanitizers) against
+ * the exact record. */
 static void test_normals_from_whole_function(void **state)
 {
     (void)state;
     scene *sc = load("scenes/blobs_b.scene");
-    const unsigned levels = SANITIZED ? 6 : 8;
+    const unsigned levels = 8;
     built b;
     build_in_memory(sc, levels, BUILD_INTERVAL, 2, &b);
     const oct_tree *t = b.tree;
+    const tape *tp = &sc->surfaces[0].tape;
+    tape_dual *slots = malloc(tp->n * sizeof *slots);
+    assert_non_null(slots);
     const double h = t->edge / (double)(UINT64_C(1) << levels);
     const uint64_t n = UINT64_C(1) << levels;
-    double worst_angle = 0.0, worst_offset = 0.0;
+    double worst_angle = 0.0, worst_offset = 0.0, sum_angle = 0.0;
+    uint64_t seen = 0, near = 0;
     for (uint64_t z = 0; z < n; z++)
         for (uint64_t y = 0; y < n; y++)
             for (uint64_t x = 0; x < n; x++) {
                 const int64_t vi = find_voxel(t, x, y, z);
-                if (vi < 0)
+                if (vi < 0 || seen++ % (SANITIZED ? 7 : 1))
                     continue;
-                const uint64_t v[3] = {x, y, z};
+                const double c[3] = {t->origin[0] + ((double)x + 0.5) * h,
+                                     t->origin[1] + ((double)y + 0.5) * h,
+                                     t->origin[2] + ((double)z + 0.5) * h};
                 double nr[3], dr;
-                reference_record(&sc->surfaces[0].tape, t->origin, h, v, nr, &dr);
+                if (!exact_record(tp, slots, c, h, nr, &dr))
+                    continue; /* the surface misses the voxel: no exact record */
+                near++;
                 const uint32_t rec = t->voxels[vi];
                 float nf[3];
                 oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, nf);
                 const double dot = nf[0] * nr[0] + nf[1] * nr[1] + nf[2] * nr[2];
-                worst_angle = fmax(worst_angle, acos(fmin(1.0, dot)) * 180.0 / M_PI);
+                const double angle = acos(fmin(1.0, dot)) * 180.0 / M_PI;
+                sum_angle += angle;
+                worst_angle = fmax(worst_angle, angle);
                 const double d = oct_offset_decode((int8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
                 worst_offset = fmax(worst_offset, fabs(d - dr));
             }
-    print_message("blobs_b levels %u: worst normal %.4f deg, worst offset %.4f voxel\n", levels,
+    assert_true(near > 0);
+    print_message("blobs_b levels %u: %llu voxels near the surface: normal %.4f mean, %.4f worst deg, "
+                  "worst offset %.4f voxel\n", levels, (unsigned long long)near, sum_angle / (double)near,
                   worst_angle, worst_offset);
-    assert_true(worst_angle < 0.1);            /* the 24-bit code: 0.06 deg */
-    assert_true(worst_offset < 1.0 / 256 + 1e-9); /* half a 1/128 step */
+    assert_true(sum_angle / (double)near < 0.1); /* measured 0.051 */
+    assert_true(worst_angle < 1.5);               /* measured 0.99 where curvature is high */
+    assert_true(worst_offset < 0.012);            /* half a 1/128 step plus curvature: 0.0082 */
+    free(slots);
     built_free(&b);
     scene_free(sc);
 }
@@ -381,6 +438,7 @@ int main(void)
         cmocka_unit_test(test_interval_method_loses_nothing),
         cmocka_unit_test(test_lipschitz_method_loses_nothing),
         cmocka_unit_test(test_output_independent_of_threads),
+        cmocka_unit_test(test_shell_only_same_voxels),
         cmocka_unit_test(test_sphere_normals_and_offsets),
         cmocka_unit_test(test_normals_from_whole_function),
         cmocka_unit_test(test_undefined_half_space_is_empty),

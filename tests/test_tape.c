@@ -372,6 +372,45 @@ static void test_grad_lanes(void **state)
     }
 }
 
+/* The gradient evaluators take sin and cos of one argument together
+ * (sincos): the value and the derivative must keep the bits of sin and cos
+ * called apart, as tape_eval computes them, over many magnitudes. */
+static void test_trig_gradient_bits(void **state)
+{
+    (void)state;
+    static const char *texts[2] = {"bounds -1 -1 -1 1 1 1\nsurface sin(x)\n",
+                                   "bounds -1 -1 -1 1 1 1\nsurface cos(x)\n"};
+    static const double scales[] = {1e-300, 1e-8, 1.0, 3.0, 1e2, 1e6, 1e15, 1e300};
+    uint64_t st = 0x9e3779b97f4a7c15ULL;
+    for (int k = 0; k < 2; k++) {
+        scene *s = NULL;
+        scene_error e;
+        assert_int_equal(scene_parse(texts[k], strlen(texts[k]), &s, &e), 0);
+        const tape *t = &s->surfaces[0].tape;
+        tape_dual duals[8];
+        static tape_dual_lanes lslots[8];
+        for (size_t j = 0; j < sizeof scales / sizeof *scales; j++)
+            for (int i = 0; i < 20000 / SCALE; i++) {
+                double x[TAPE_LANES], y[TAPE_LANES] = {0}, z[TAPE_LANES] = {0}, f[TAPE_LANES];
+                double g[3][TAPE_LANES];
+                for (unsigned l = 0; l < TAPE_LANES; l++) {
+                    x[l] = (2.0 * rng_unit(rng_xorshift64(&st)) - 1.0) * scales[j];
+                }
+                tape_eval_grad_lanes(t, TAPE_LANES, x, y, z, f, g, lslots);
+                for (unsigned l = 0; l < TAPE_LANES; l++) {
+                    double p[3] = {x[l], 0.0, 0.0}, g1[3];
+                    double f1 = tape_eval_grad(t, p, g1, duals);
+                    double v = k ? cos(x[l]) : sin(x[l]), d = k ? -sin(x[l]) : cos(x[l]);
+                    if (!same_bits(f1, v) || !same_bits(g1[0], d) || !same_bits(f[l], v) ||
+                        !same_bits(g[0][l], d))
+                        fail_msg("%s at %a: %a %a, lanes %a %a, libm %a %a", texts[k], x[l], f1,
+                                 g1[0], f[l], g[0][l], v, d);
+                }
+            }
+        scene_free(s);
+    }
+}
+
 /* Documented rules for undefined points (TESTPLAN 23, 24). */
 static void test_undefined_points(void **state)
 {
@@ -408,6 +447,7 @@ int main(void)
         cmocka_unit_test(test_gradient_vs_differences),
         cmocka_unit_test(test_interval_scenes),
         cmocka_unit_test(test_grad_lanes),
+        cmocka_unit_test(test_trig_gradient_bits),
         cmocka_unit_test(test_undefined_points),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -75,8 +75,8 @@ double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dua
         case TAPE_EXP: { double v = exp(a->v); dscale(r, a, v, v); break; }
         case TAPE_LOG: dscale(r, a, log(a->v), 1.0 / a->v); break;
         case TAPE_ABS: dscale(r, a, fabs(a->v), a->v < 0.0 ? -1.0 : 1.0); break;
-        case TAPE_SIN: dscale(r, a, sin(a->v), cos(a->v)); break;
-        case TAPE_COS: dscale(r, a, cos(a->v), -sin(a->v)); break;
+        case TAPE_SIN: { double sv, cv; point_sincos(a->v, &sv, &cv); dscale(r, a, sv, cv); break; }
+        case TAPE_COS: { double sv, cv; point_sincos(a->v, &sv, &cv); dscale(r, a, cv, -sv); break; }
         case TAPE_TAN: { double v = tan(a->v); dscale(r, a, v, 1.0 + v * v); break; }
         case TAPE_ADD:
         case TAPE_SUB: {

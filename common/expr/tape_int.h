@@ -3,6 +3,8 @@
 #ifndef TAPE_INT_H
 #define TAPE_INT_H
 
+#include <math.h>
+
 #include "common/expr/tape.h"
 
 /* min and max in double that propagate NaN from either operand. The
@@ -10,6 +12,19 @@
  * and evaluated values agree bit for bit. */
 static inline double point_min(double a, double b) { return (a < b || a != a) ? a : b; }
 static inline double point_max(double a, double b) { return (a > b || a != a) ? a : b; }
+
+/* sin(x) and cos(x) for the gradient evaluators, which want both: glibc's
+ * sincos shares the argument reduction and returns the same bits as sin and
+ * cos called apart (tests/test_tape.c checks it); elsewhere, the two calls. */
+static inline void point_sincos(double x, double *s, double *c)
+{
+#if defined(__GLIBC__)
+    sincos(x, s, c);
+#else
+    *s = sin(x);
+    *c = cos(x);
+#endif
+}
 
 /* Operand slots of an instruction, 0 where the field is not a slot (a
  * constant-pool index, or unused), so that no pointer is formed outside

@@ -81,18 +81,17 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             SCALE(r, A, m);
             break;
         case TAPE_SIN:
-            for (unsigned l = 0; l < n; l++) {
-                r->v[l] = sin(A->v[l]);
-                m[l] = cos(A->v[l]);
-            }
+            for (unsigned l = 0; l < n; l++)
+                point_sincos(A->v[l], &r->v[l], &m[l]);
             fill(r->v, n);
             fill(m, n);
             SCALE(r, A, m);
             break;
         case TAPE_COS:
             for (unsigned l = 0; l < n; l++) {
-                r->v[l] = cos(A->v[l]);
-                m[l] = -sin(A->v[l]);
+                double sv;
+                point_sincos(A->v[l], &sv, &r->v[l]);
+                m[l] = -sv;
             }
             fill(r->v, n);
             fill(m, n);
