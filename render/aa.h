@@ -17,6 +17,7 @@
 /* What the edge test keeps of a pixel's centre ray. */
 typedef struct aa_probe {
     float t;
+    float t_lo;       /* the beam's start for the centre ray's sub-block (rounded down) */
     float n[3];
     uint16_t surface;
     uint8_t hit;

@@ -133,7 +133,8 @@ static void shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit
 /* Traces, shades and stores pixel (i, j)'s centre ray; r is its prepared
  * ray, or NULL for a ray known to miss. */
 static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t i, uint32_t j,
-                                const double dir[3], const trace_ray *r, const trace_anchor *an)
+                                const double dir[3], const trace_ray *r, const trace_anchor *an,
+                                double t_lo)
 {
     const frame_job *job = sh->job;
     trace_hit h;
@@ -167,6 +168,10 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
         p->surface = h.hit && job->tree->surfaces ? job->tree->surfaces[h.voxel] : 0;
         for (int a = 0; a < 3; a++)
             p->n[a] = n[a];
+        float f = (float)t_lo; /* rounded down: a start never late */
+        if ((double)f > t_lo)
+            f = nextafterf(f, -INFINITY);
+        p->t_lo = f;
     }
     acc->hits += (uint64_t)h.hit;
     acc->steps += h.steps;
@@ -194,7 +199,7 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
         g.t_lo[0][0] = 0.0;
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
-        render_pixel(sh, acc, i0, j0, cam->forward, NULL, NULL);
+        render_pixel(sh, acc, i0, j0, cam->forward, NULL, NULL, INFINITY);
         const size_t p0 = (size_t)j0 * cam->width + i0, w = i1 - i0;
         uint8_t *row0 = job->rgb + 3 * p0;
         for (size_t k = 1; k < w; k++)
@@ -225,7 +230,7 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
             if (!(t_lo < INFINITY)) { /* every ray of the sub-block misses: no direction */
                 for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++)
                     for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++)
-                        render_pixel(sh, acc, i, j, cam->forward, NULL, NULL);
+                        render_pixel(sh, acc, i, j, cam->forward, NULL, NULL, INFINITY);
                 continue;
             }
             /* the sub-block's rays all start at t_lo: where they do, the
@@ -247,10 +252,46 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
                     trace_ray r;
                     const int traced =
                         trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY);
-                    render_pixel(sh, acc, i, j, dir, traced ? &r : NULL, &an);
+                    render_pixel(sh, acc, i, j, dir, traced ? &r : NULL, &an, t_lo);
                 }
             }
         }
+}
+
+/* The first pixel of the beam block holding pixel k along an axis of n
+ * pixels, and its end. */
+static void block_span(const frame_job *job, uint32_t k, uint32_t n, uint32_t *k0, uint32_t *k1)
+{
+    const uint32_t bs = job->beam_size, t0 = k / FRAME_TILE * FRAME_TILE;
+    const uint32_t t1 = t0 + FRAME_TILE < n ? t0 + FRAME_TILE : n;
+    *k0 = t0 + (k - t0) / bs * bs;
+    *k1 = *k0 + bs < t1 ? *k0 + bs : t1;
+}
+
+/* Where the samples of pixel (i, j) may start (+inf: they all miss). Its
+ * square lies within the centre rays of the 3 x 3 pixels around it; when
+ * those are all in one beam block, their rays are in the block's pyramid,
+ * which its sub-blocks' pyramids tile, so no sample meets an occupied voxel
+ * before the least of those sub-blocks' starts (beam.h). Pixels at a
+ * block's border, and --beam 0, start at the eye. */
+static double sample_start(const frame_shared *sh, uint32_t i, uint32_t j)
+{
+    const frame_job *job = sh->job;
+    const camera *cam = job->cam;
+    if (!job->beam_size)
+        return 0.0;
+    uint32_t i0, i1, j0, j1;
+    block_span(job, i, cam->width, &i0, &i1);
+    block_span(job, j, cam->height, &j0, &j1);
+    if (i < i0 + 1 || i + 2 > i1 || j < j0 + 1 || j + 2 > j1)
+        return 0.0;
+    float lo = INFINITY;
+    for (uint32_t y = j - 1; y <= j + 1; y++)
+        for (uint32_t x = i - 1; x <= i + 1; x++) {
+            const float t = sh->probes[(size_t)y * cam->width + x].t_lo;
+            lo = t < lo ? t : lo;
+        }
+    return lo;
 }
 
 /* Pixel (i, j) again with job->aa x job->aa samples (aa.h), the colour
@@ -265,6 +306,7 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     const double w = (double)cam->width, hh = (double)cam->height;
     float sum[3] = {0.0f, 0.0f, 0.0f};
     unsigned hits = 0;
+    const double t_lo = sample_start(sh, i, j);
     for (unsigned k = 0; k < ns; k++) {
         double fx, fy, dir[3];
         aa_sample_offset(na, k, &fx, &fy);
@@ -273,7 +315,7 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
         camera_ray_uv(cam, u, v, dir);
         trace_ray r;
         trace_hit h;
-        if (trace_setup_eye(eye, dir, &r)) {
+        if (t_lo < INFINITY && trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY)) {
             sh->traverse(job->tree, &job->opts, &r, NULL, &h);
         } else {
             h.hit = 0;

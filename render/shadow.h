@@ -5,18 +5,22 @@
  * crosses), which is what the primary traversal does too, so no third
  * traversal is needed.
  *
- * Start point (RENDER.md, "Shadows"): the centre of the hit voxel moved
- * SHADOW_OFFSET(n) voxel edges along the viewer-facing normal n, where
- *     SHADOW_OFFSET(n) = 1.5 * |n|_1 + 0.25   (1.75 .. 2.85 voxels).
+ * Start point (RENDER.md, "Shadows"): from the hit voxel's stored plane
+ * n . (p - centre) = offset (the plane --refine uses), the point of that
+ * plane nearest the voxel's centre moved SHADOW_OFFSET(n) voxel edges along
+ * the viewer-facing normal, where
+ *     SHADOW_OFFSET(n) = |n|_1 + 0.25   (1.25 .. 1.99 voxels).
  * For a plane with unit normal n, a voxel meets it only when its centre is
  * within |n|_1 / 2 of it, so every point of every voxel of the plane is
- * within |n|_1; the start point is at least |n|_1 + 0.25 away on the
- * facing side, and a ray leaving it with d . n > 0 only gets farther: a
- * surface never shadows itself (no acne). A point whose light lies behind
- * its facing normal gets no light at all (no shadow ray), so a wall can
- * only be lit from the side it is seen from: light cannot leak through
- * it, however thin. What the offset skips is an occluder nearer than
- * SHADOW_OFFSET along the normal (under 3 voxels). */
+ * within |n|_1; the start point is |n|_1 + 0.25 away on the facing side
+ * (the 0.25 covers the stored normal's and offset's rounding), and a ray
+ * leaving it with d . n > 0 only gets farther: a surface never shadows
+ * itself (no acne). A point whose light lies behind its facing normal gets
+ * no light at all (no shadow ray), so a wall can only be lit from the side
+ * it is seen from: light cannot leak through it, however thin. What the
+ * offset skips is an occluder nearer than SHADOW_OFFSET along the normal
+ * (under 2 voxels); a shadow's outline moves by up to SHADOW_OFFSET times
+ * the sine of the light's angle to the normal. */
 #ifndef SHADOW_H
 #define SHADOW_H
 
