@@ -39,11 +39,37 @@ float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn 
                 uint32_t seed, uint64_t *steps)
 {
     const double dist = AO_DISTANCE * tree->edge;
+    if (!traverse)
+        traverse = trace_impls[0].traverse;
+    /* the rays share their start: its grid position once, and the deepest
+       occupied cell around it, where every ray's descent would arrive */
+    trace_eye e;
+    if (!trace_eye_init(tree, o, &e))
+        return 1.0f; /* as trace_setup: no ray, nothing in the way */
+    trace_anchor an;
+    an.depth = 0;
+    if (e.inside[0] && e.inside[1] && e.inside[2]) {
+        const double margin = 0x1p-10 + 0x1p-36 * e.n;
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = e.o[a] - margin;
+            hi[a] = e.o[a] + margin;
+        }
+        trace_anchor_find(tree, lo, hi, &an);
+    }
     unsigned open = 0;
     for (unsigned k = k0; k < k0 + count; k++) {
         double d[3];
         ao_direction(n, k, m, seed, d);
-        open += !shadow_blocked(tree, opts, traverse, o, d, dist, steps);
+        trace_ray r;
+        if (!trace_setup_eye(&e, d, &r) || !trace_clip(&r, 0.0, dist)) {
+            open++;
+            continue;
+        }
+        trace_hit h;
+        traverse(tree, opts, &r, &an, &h);
+        *steps += h.steps;
+        open += !h.hit;
     }
     return (float)open / (float)count;
 }
