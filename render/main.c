@@ -20,6 +20,7 @@
 #include "render/aa.h"
 #include "render/ao.h"
 #include "render/frame.h"
+#include "render/framing.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/views.h"
@@ -41,7 +42,7 @@ static const char help_text[] =
     "Ray traces the voxels of FILE.oct (two-step discrete ray tracing).\n"
     "  -o OUT.png          colour image (8-bit sRGB PNG)\n"
     "  --size WxH          image size in pixels (default 512x512, each 1.." LIMIT_STR(CAMERA_MAX_SIZE) ")\n"
-    "  --eye, --target     camera position and aim (default: a view framing the cube)\n"
+    "  --eye, --target     camera position and aim (default: a view framing the occupied voxels)\n"
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
     "  --fov DEG           vertical field of view, in (0, 180) (default 30)\n"
     "  --depth OUT.pfm     distance along each pixel's unit ray (PFM, +inf on miss)\n"
@@ -139,27 +140,6 @@ static int is_pfm(const char *path)
 {
     size_t n = strlen(path);
     return n >= 4 && strcmp(path + n - 4, ".pfm") == 0;
-}
-
-/* A view that frames the root cube: aim at its centre from the direction of
- * the benchmark view, far enough that its bounding sphere fits the fov. */
-static void frame_cube(const oct_tree *t, views_view *v)
-{
-    double c[3];
-    for (int a = 0; a < 3; a++)
-        c[a] = t->origin[a] + 0.5 * t->edge;
-    if (!v->has_target)
-        memcpy(v->target, c, sizeof c);
-    if (!v->has_eye) {
-        static const double dir[3] = {1.7, 1.1, 1.4};
-        double n = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-        double h = tan(v->fov * M_PI / 360.0);
-        if (v->width < v->height)
-            h = h * (double)v->width / (double)v->height;
-        double dist = 1.05 * (0.5 * sqrt(3.0) * t->edge) / sin(atan(h));
-        for (int a = 0; a < 3; a++)
-            v->eye[a] = v->target[a] + dist * dir[a] / n;
-    }
 }
 
 /* The command line. */
@@ -341,7 +321,7 @@ static int open_tree(const render_args *o, oct_file **file)
 static int command_line_views(const oct_tree *tree, const render_args *o, views_view *base,
                               views_view **list, size_t *nviews)
 {
-    frame_cube(tree, base);
+    framing_default_view(tree, base);
     if (o->orbit) {
         *list = views_orbit(base, (unsigned)o->orbit, base->out);
         if (!*list)
@@ -378,7 +358,7 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     }
     size_t max_px = 0;
     for (size_t k = 0; k < nviews; k++) {
-        frame_cube(tree, &list[k]);
+        framing_default_view(tree, &list[k]);
         camera_err ce = camera_init(&(*cams)[k], list[k].eye, list[k].target, list[k].up,
                                     list[k].fov, list[k].width, list[k].height);
         if (ce != CAMERA_OK) {
