@@ -109,7 +109,8 @@ static void shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit
     if (h->hit && (shadow || ao_count)) {
         const double t0 = job->timing ? now_ns() : 0.0;
         double o[3];
-        shadow_origin(job->tree, h, n, o);
+        if (!shadow_origin(job->tree, h, n, o))
+            goto lit; /* no start off the surface: lit and open */
         if (shadow) {
             acc->shadow_rays++;
             if (shadow_blocked(job->tree, &job->opts, sh->traverse, o, job->shade.light,
@@ -121,6 +122,7 @@ static void shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit
                            ao_seed(i, j), &acc->secondary_steps);
             acc->ao_rays += ao_count;
         }
+    lit:
         if (job->timing)
             acc->secondary_ns += now_ns() - t0;
     }

@@ -20,7 +20,8 @@
  * it is seen from: light cannot leak through it, however thin. What the
  * offset skips is an occluder nearer than SHADOW_OFFSET along the normal
  * (under 2 voxels); a shadow's outline moves by up to SHADOW_OFFSET times
- * the sine of the light's angle to the normal. */
+ * the sine of the light's angle to the normal. A start point inside an
+ * occupied voxel is moved on (shadow_origin). */
 #ifndef SHADOW_H
 #define SHADOW_H
 
@@ -33,9 +34,16 @@
 /* The offset rule above, in voxel edges, for a unit normal n. */
 double shadow_offset(const float n[3]);
 
+#define SHADOW_TRIES 3
+
 /* World position of the start point of secondary rays from the hit voxel
- * `hit` (hit->hit set) with viewer-facing unit normal n. */
-void shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3]);
+ * `hit` (hit->hit set) with viewer-facing unit normal n, in o; returns 1.
+ * Where that point falls in an occupied voxel (at a crease, or where
+ * surfaces crowd: the voxel's normal does not point to open space), it
+ * moves one voxel further along n, up to SHADOW_TRIES - 1 times; returns 0
+ * when it is still inside one (the caller then treats the point as lit and
+ * open: a start inside the surface would shadow it by itself). */
+int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3]);
 
 /* 1 when the ray o + t d (d unit), 0 <= t <= t_max (+inf allowed), meets an
  * occupied voxel (by opts' rule), traced by `traverse` (NULL: the build's

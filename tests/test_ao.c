@@ -57,7 +57,7 @@ static float factor_at(const oct_tree *t, const trace_opts *o, trace_traverse_fn
         for (int a = 0; a < 3; a++)
             n[a] = -n[a];
     double org[3];
-    shadow_origin(t, &h, n, org);
+    assert_true(shadow_origin(t, &h, n, org));
     uint64_t steps = 0;
     return ao_factor(t, o, fn, org, n, 0, rays, rays, ao_seed((uint32_t)x, (uint32_t)y), &steps);
 }

@@ -75,7 +75,7 @@ static void acne_voxel(const oct_tree *t, uint64_t k, const uint32_t xyz[3], voi
         for (int a = 0; a < 3; a++)
             n[a] = -n[a];
     double o[3];
-    shadow_origin(t, &h, n, o);
+    assert_true(shadow_origin(t, &h, n, o));
     uint64_t steps = 0;
     c->tested++;
     c->blocked += (unsigned)shadow_blocked(t, &c->opts, c->fn, o, c->light, INFINITY, &steps);
@@ -156,7 +156,7 @@ static void test_thin_wall_does_not_leak(void **state)
                     assert_true(trace_ray_cast(t, &o, eye, down, &h));
                     float n[3] = {0, 0, 1};
                     double org[3];
-                    shadow_origin(t, &h, n, org);
+                    assert_true(shadow_origin(t, &h, n, org));
                     uint64_t steps = 0;
                     int b = shadow_blocked(t, &o, trace_impls[impl].traverse, org, light,
                                            INFINITY, &steps);
