@@ -17,7 +17,7 @@
 
 /* What a thread adds up. */
 typedef struct frame_acc {
-    uint64_t rays, hits, steps, aa_pixels, shadow_rays, ao_rays, secondary_steps;
+    uint64_t rays, hits, steps, aa_pixels, aa_full, shadow_rays, ao_rays, secondary_steps;
     double secondary_ns;
 } frame_acc;
 
@@ -296,8 +296,43 @@ static double sample_start(const frame_shared *sh, uint32_t i, uint32_t j)
     return lo;
 }
 
-/* Pixel (i, j) again with job->aa x job->aa samples (aa.h), the colour
- * averaged in linear light; AO rays shared out over the samples. */
+/* Sample k of pixel (i, j) (aa.h's order), traced from t_lo and shaded
+ * with AO rays k * per .. of per * N^2; its colour in rgb, what the edge
+ * test keeps of it in p. */
+static void trace_sample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
+                         uint32_t j, unsigned k, double t_lo, unsigned per, float rgb[3],
+                         aa_probe *p)
+{
+    const frame_job *job = sh->job;
+    const camera *cam = job->cam;
+    const unsigned na = job->aa;
+    const double w = (double)cam->width, hh = (double)cam->height;
+    double fx, fy, dir[3];
+    aa_sample_offset(na, k, &fx, &fy);
+    const double u = (2.0 * ((double)i + fx) / w - 1.0) * cam->h * w / hh;
+    const double v = (1.0 - 2.0 * ((double)j + fy) / hh) * cam->h;
+    camera_ray_uv(cam, u, v, dir);
+    trace_ray r;
+    trace_hit h;
+    if (t_lo < INFINITY && trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY)) {
+        sh->traverse(job->tree, &job->opts, &r, NULL, &h);
+    } else {
+        h.hit = 0;
+        h.t = INFINITY;
+        h.steps = 0;
+    }
+    acc->rays++;
+    acc->steps += h.steps;
+    shade_sample(sh, acc, &h, dir, i, j, k * per, per, per * na * na, rgb, p->n);
+    p->hit = (uint8_t)h.hit;
+    p->t = h.hit ? (float)h.t : INFINITY;
+    p->surface = h.hit && job->tree->surfaces ? job->tree->surfaces[h.voxel] : 0;
+}
+
+/* Pixel (i, j) again with samples (aa.h): the four corner samples of the
+ * N x N grid first; when they and the centre ray all agree by the edge
+ * rule, the pixel holds no edge and they are its colour; otherwise all
+ * N x N. Colours averaged in linear light; AO rays shared out. */
 static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
                         uint32_t j)
 {
@@ -305,41 +340,40 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     const camera *cam = job->cam;
     const unsigned na = job->aa, ns = na * na, ao = job->shade.ao_rays;
     const unsigned per = ao ? (ao / ns > 0 ? ao / ns : 1) : 0;
-    const double w = (double)cam->width, hh = (double)cam->height;
+    const size_t px = (size_t)j * cam->width + i;
+    const unsigned corner[4] = {0, na - 1, ns - na, ns - 1};
     float sum[3] = {0.0f, 0.0f, 0.0f};
-    unsigned hits = 0;
+    unsigned hits = 0, done = 0;
+    int uniform = 1;
     const double t_lo = sample_start(sh, i, j);
     for (unsigned k = 0; k < ns; k++) {
-        double fx, fy, dir[3];
-        aa_sample_offset(na, k, &fx, &fy);
-        const double u = (2.0 * ((double)i + fx) / w - 1.0) * cam->h * w / hh;
-        const double v = (1.0 - 2.0 * ((double)j + fy) / hh) * cam->h;
-        camera_ray_uv(cam, u, v, dir);
-        trace_ray r;
-        trace_hit h;
-        if (t_lo < INFINITY && trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY)) {
-            sh->traverse(job->tree, &job->opts, &r, NULL, &h);
-        } else {
-            h.hit = 0;
-            h.t = INFINITY;
-            h.steps = 0;
-        }
-        acc->rays++;
-        acc->steps += h.steps;
-        float rgb[3], n[3];
-        shade_sample(sh, acc, &h, dir, i, j, k * per, per, per * ns, rgb, n);
-        hits += (unsigned)h.hit;
-        if (h.hit || !job->alpha)
+        int is_corner = 0;
+        for (unsigned c = 0; c < 4; c++)
+            is_corner |= k == corner[c];
+        const int pass = done < 4 ? 0 : 1; /* corners, then the rest */
+        if (pass == 0 ? !is_corner : is_corner)
+            continue;
+        float rgb[3];
+        aa_probe p;
+        trace_sample(sh, acc, eye, i, j, k, t_lo, per, rgb, &p);
+        uniform &= !aa_differs(&p, &sh->probes[px]);
+        hits += p.hit;
+        if (p.hit || !job->alpha)
             for (int a = 0; a < 3; a++)
                 sum[a] += rgb[a];
+        if (++done == 4) {
+            if (uniform)
+                break;
+            k = (unsigned)-1; /* the rest, from the start */
+        }
     }
-    const size_t px = (size_t)j * cam->width + i;
-    const float div = job->alpha ? (float)(hits ? hits : 1) : (float)ns;
+    const float div = job->alpha ? (float)(hits ? hits : 1) : (float)done;
     for (int a = 0; a < 3; a++)
         job->rgb[3 * px + (size_t)a] = srgb8_fast(sum[a] / div);
     if (job->alpha)
-        job->alpha[px] = (uint8_t)((hits * 255u + ns / 2) / ns);
+        job->alpha[px] = (uint8_t)((hits * 255u + done / 2) / done);
     acc->aa_pixels++;
+    acc->aa_full += done == ns;
 }
 
 /* The antialiasing pass over [i0, i1) x [j0, j1): samples where needed. */
@@ -397,6 +431,7 @@ static void work(frame_shared *sh, int caller)
     sh->sum.hits += acc.hits;
     sh->sum.steps += acc.steps;
     sh->sum.aa_pixels += acc.aa_pixels;
+    sh->sum.aa_full += acc.aa_full;
     sh->sum.shadow_rays += acc.shadow_rays;
     sh->sum.ao_rays += acc.ao_rays;
     sh->sum.secondary_steps += acc.secondary_steps;
@@ -468,6 +503,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
     stats->hits = sh.sum.hits;
     stats->steps = sh.sum.steps;
     stats->aa_pixels = sh.sum.aa_pixels;
+    stats->aa_full = sh.sum.aa_full;
     stats->shadow_rays = sh.sum.shadow_rays;
     stats->ao_rays = sh.sum.ao_rays;
     stats->secondary_steps = sh.sum.secondary_steps;

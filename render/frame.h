@@ -45,7 +45,8 @@ typedef struct frame_job {
 typedef struct frame_stats {
     uint64_t rays, hits, steps; /* primary rays (centre rays and samples), centre rays
                                    that hit, their DDA steps */
-    uint64_t aa_pixels;         /* pixels traced again with samples */
+    uint64_t aa_pixels;         /* pixels traced again with samples (the edge test) */
+    uint64_t aa_full;           /* of those, with all N x N (their corners disagreed) */
     uint64_t shadow_rays, ao_rays, secondary_steps;
     double primary_ns, secondary_ns; /* with job->timing: thread time summed over
                                         threads, spent on each kind of ray */

@@ -412,7 +412,8 @@ static void report_view(const render_args *o, const views_view *v, const frame_s
             v->height, ms, ms > 0 ? (double)st->rays / ms / 1e3 : 0.0,
             100.0 * (double)st->hits / (double)px);
     if (v->aa > 1)
-        fprintf(stderr, ", %.2f%% supersampled", 100.0 * (double)st->aa_pixels / (double)px);
+        fprintf(stderr, ", %.2f%% edge pixels, %.2f%% supersampled",
+                100.0 * (double)st->aa_pixels / (double)px, 100.0 * (double)st->aa_full / (double)px);
     if (o->verbose) {
         const double th = (double)o->threads;
         fprintf(stderr, "; primary %.2f Mrays %.2f Mrays/s", (double)st->rays / 1e6,

@@ -103,9 +103,9 @@ static void test_coverage_matches_disc(void **state)
                 }
             }
         print_message("refine %d: %u silhouette pixels, mean |alpha - exact| %.4f there, "
-                      "%.5f over the image, %.1f%% supersampled\n",
+                      "%.5f over the image, %.1f%% edge pixels, %.1f%% supersampled\n",
                       refine, edge, sum_edge / edge, sum_all / (W * H),
-                      100.0 * (double)st.aa_pixels / (W * H));
+                      100.0 * (double)st.aa_pixels / (W * H), 100.0 * (double)st.aa_full / (W * H));
         assert_true(edge > 60);
         assert_true(sum_edge / edge <= 0.08);
         assert_true(sum_all / (W * H) <= 0.002);
@@ -132,14 +132,17 @@ static void test_deterministic_and_centre_depth(void **state)
     render(&s, 3, 0, NULL, 1, ref, aref, depth, &st);
     assert_memory_equal(depth, dref, np * sizeof *depth);
     assert_true(st.aa_pixels > 0 && st.aa_pixels < np / 4);
-    assert_true(st.rays == np + 9 * st.aa_pixels);
+    /* 3 x 3: the four corners of each edge pixel, the five others where
+       those disagree */
+    assert_true(st.rays == np + 4 * st.aa_pixels + 5 * st.aa_full);
+    assert_true(st.aa_full > 0 && st.aa_full < st.aa_pixels);
     for (unsigned impl = 0; impl < trace_impl_count; impl++)
         for (unsigned th = 1; th <= 5; th += 2) {
             render(&s, 3, 0, trace_impls[impl].traverse, th, rgb, alpha, depth, &st1);
             assert_memory_equal(rgb, ref, np * 3);
             assert_memory_equal(alpha, aref, np);
             assert_memory_equal(depth, dref, np * sizeof *depth);
-            assert_true(st1.aa_pixels == st.aa_pixels);
+            assert_true(st1.aa_pixels == st.aa_pixels && st1.aa_full == st.aa_full);
         }
     /* a pixel that is not supersampled keeps its one ray's colour; one
        whose alpha is partial was supersampled */
@@ -147,7 +150,7 @@ static void test_deterministic_and_centre_depth(void **state)
     for (size_t k = 0; k < np; k++)
         if (aref[k] != 0 && aref[k] != 255)
             partial++;
-    assert_true(partial > 20 && partial <= st.aa_pixels);
+    assert_true(partial > 20 && partial <= st.aa_full);
     free(rgb);
     free(ref);
     free(alpha);
