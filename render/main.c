@@ -461,7 +461,9 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
         job.progress = progress_bar;
     frame_stats st;
     double t0 = now_ms();
-    frame_render(&job, &st);
+    const int rc = frame_render(&job, &st);
+    if (rc != 0) /* fewer threads, or (out of memory for --aa) one ray a pixel */
+        fprintf(stderr, "render: %s: %s: rendered with what could be had\n", v->out, strerror(rc));
     double ms = now_ms() - t0;
     *total_ms += ms;
     *total_rays += st.rays;
