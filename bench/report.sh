@@ -72,14 +72,22 @@ if [ -f "$RES/images.csv" ]; then
     echo "|---|---|---|---|"
     echo "| ![plain]($RES/images/plain.png) | ![aa]($RES/images/aa.png) | ![shadows]($RES/images/shadows.png) | ![ao]($RES/images/ao.png) |"
 fi
+if [ -f "$RES/shard_summary.txt" ]; then
+    echo
+    echo "Sharded rasterization (\`bench/shard.sh\`: the shards run two at a time on this machine, then \`--merge\`;"
+    echo "the merged file is the whole run's byte for byte; the projection is the longest-first makespan"
+    echo "of the measured shard CPU times on W workers):"
+    echo
+    sed 's/^/    /' "$RES/shard_summary.txt"
+fi
 echo
 cat "$RES/figure4.md"
 echo
-for p in error_vs_time p99_vs_time rasterize_time rasterize_bytes; do
+for p in error_vs_time p99_vs_time rasterize_time rasterize_bytes shard_scale; do
     [ -f "$RES/$p.png" ] && echo "![$p]($RES/$p.png)"
 done
 echo
-echo "CSV files: \`$RES/\` (rasterize, render, refcast, figure4, povray, images)."
+echo "CSV files: \`$RES/\` (rasterize, render, refcast, figure4, povray, shard, shard_scale, images)."
 echo "<!-- bench:end -->"
 } >"$T.new"
 if grep -q '<!-- bench:begin -->' "$README"; then
