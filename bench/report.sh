@@ -74,6 +74,20 @@ if [ "$(wc -l <"$RES/povray.csv")" -gt 1 ]; then
     echo "|---|---|---|---|---|---|---|---|---|"
     awk -F, 'NR > 1 { printf "| %s | %d² | %s | %.2f | %.3f | %.1f | %.1f | %.3f | %s |\n", $6, $7, $8, $10, 100 * $11, $12, $13, 100 * $14, $15 }' "$RES/povray.csv"
 fi
+if [ -f "$RES/images.csv" ]; then
+    echo
+    echo "Images people want to look at: \`blobs_a\`, standard view, against one ray a pixel"
+    echo "(rates over thread time; secondary = shadow and AO rays):"
+    echo
+    echo "| option | levels | size | ms | time / plain | supersampled % | primary Mrays/s | secondary Mrays/s |"
+    echo "|---|---|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { o = $10 == "plain" ? "one ray a pixel" : $10 == "aa" ? "--aa 4" : $10 == "ao" ? "--ao 16" : "--" $10
+        printf "| %s | %d | %d² | %.1f | %.2f | %.2f | %s | %s |\n", o, $7, $8, $11, $12, $13, $14, $15 }' "$RES/images.csv"
+    echo
+    echo "| plain | --aa 4 | --shadows | --ao 16 |"
+    echo "|---|---|---|---|"
+    echo "| ![plain]($RES/images/plain.png) | ![aa]($RES/images/aa.png) | ![shadows]($RES/images/shadows.png) | ![ao]($RES/images/ao.png) |"
+fi
 if [ -f "$RES/shard_summary.txt" ]; then
     echo
     echo "Sharded rasterization (\`bench/shard.sh\`: the shards run two at a time on this machine, then \`--merge\`;"
@@ -89,7 +103,7 @@ for p in error_vs_time p99_vs_time rasterize_time rasterize_bytes shard_scale; d
     [ -f "$RES/$p.png" ] && echo "![$p]($RES/$p.png)"
 done
 echo
-echo "CSV files: \`$RES/\` (rasterize, rastspeed, shell, render, refcast, figure4, povray, shard, shard_scale)."
+echo "CSV files: \`$RES/\` (rasterize, rastspeed, shell, render, refcast, figure4, povray, shard, shard_scale, images)."
 echo "<!-- bench:end -->"
 } >"$T.new"
 if grep -q '<!-- bench:begin -->' "$README"; then

@@ -211,6 +211,10 @@ for s in blobs_a blobs_b; do
     done
 done
 
+# ---- Images: --aa 4, --shadows, --ao 16 against one ray a pixel ----
+BIN=$BIN RES=$RES WORK=$WORK PROV=$PROV PROVH=$PROVH REPS=$REPS SIZE=$SIZE FIG_LEVELS=$FIG_LEVELS \
+    sh "$D/images.sh"
+
 # ---- POV-Ray: blobs_a and blobs_b, standard view, two accuracies ----
 echo "$PROVH,scene,size,accuracy,max_gradient,pov_s,pov_hitmiss_frac,ours_ms,ours_refine_ms,ours_hitmiss_frac,pov_over_ours" >"$POV"
 if have povray; then

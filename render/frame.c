@@ -8,18 +8,40 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "common/test_hooks.h"
 #include "common/view/image.h"
-#include "render/map_guard.h"
+#include "render/ao.h"
 #include "render/beam.h"
+#include "render/map_guard.h"
+#include "render/shadow.h"
+
+/* What a thread adds up. */
+typedef struct frame_acc {
+    uint64_t rays, hits, steps, aa_pixels, aa_full, shadow_rays, ao_rays, secondary_steps;
+    double secondary_ns;
+} frame_acc;
 
 typedef struct frame_shared {
     const frame_job *job;
+    trace_traverse_fn traverse;
+    aa_probe *probes; /* centre rays, for the antialiasing pass; NULL without */
+    int phase;        /* 0: centre rays; 1: samples where needed */
     uint32_t tiles_x, tiles_y;
-    atomic_uint_fast64_t next, done, hits, steps;
+    atomic_uint_fast64_t next, done;
     atomic_int changed; /* set when map_guard abandoned a thread's work */
+    pthread_mutex_t lock; /* guards the sums below */
+    frame_acc sum;
+    double thread_ns;
 } frame_shared;
+
+static double now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
 
 /* image_srgb8 without pow: the code value is the number of thresholds at or
  * below the input, where threshold k is the least float whose image_srgb8
@@ -76,22 +98,60 @@ uint8_t frame_srgb8(float x)
     return srgb8_fast(x);
 }
 
-/* Traces, shades and stores pixel (i, j); r is its prepared ray, or NULL
- * for a ray known to miss. */
-static inline void render_pixel(const frame_job *job, uint32_t i, uint32_t j, const double dir[3],
-                                const trace_ray *r, const trace_anchor *an, uint64_t *hits,
-                                uint64_t *steps)
+/* Shades a traced sample of pixel (i, j) seen along `dir`: the shadow ray,
+ * AO rays k0 .. k0 + ao_count - 1 of ao_total, the colour; n gets the
+ * facing normal. */
+static void shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit *h,
+                         const double dir[3], uint32_t i, uint32_t j, unsigned ao_k0,
+                         unsigned ao_count, unsigned ao_total, float rgb[3], float n[3])
 {
+    const frame_job *job = sh->job;
+    double lam = shade_normal(job->tree, &job->shade, h, dir, n);
+    float ao = 1.0f;
+    const int shadow = job->shade.shadows && lam > 0.0;
+    if (h->hit && (shadow || ao_count)) {
+        const double t0 = job->timing ? now_ns() : 0.0;
+        double o[3];
+        if (!shadow_origin(job->tree, h, n, o))
+            goto lit; /* no start off the surface: lit and open */
+        if (shadow) {
+            acc->shadow_rays++;
+            if (shadow_blocked(job->tree, &job->opts, sh->traverse, o, job->shade.light,
+                               INFINITY, &acc->secondary_steps))
+                lam = 0.0;
+        }
+        if (ao_count) {
+            ao = ao_factor(job->tree, &job->opts, sh->traverse, o, n, ao_k0, ao_count, ao_total,
+                           ao_seed(i, j), &acc->secondary_steps);
+            acc->ao_rays += ao_count;
+        }
+    lit:
+        if (job->timing)
+            acc->secondary_ns += now_ns() - t0;
+    }
+    if (!h->hit && job->alpha)
+        rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    else
+        shade_color(job->tree, &job->shade, h, lam, ao, rgb);
+}
+
+/* Traces, shades and stores pixel (i, j)'s centre ray; r is its prepared
+ * ray, or NULL for a ray known to miss. */
+static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t i, uint32_t j,
+                                const double dir[3], const trace_ray *r, const trace_anchor *an,
+                                double t_lo)
+{
+    const frame_job *job = sh->job;
     trace_hit h;
     if (r) {
-        trace_ray_anchored(job->tree, &job->opts, r, an, &h);
+        sh->traverse(job->tree, &job->opts, r, an, &h);
     } else { /* trace_ray_cast's miss */
         h.hit = 0;
         h.t = INFINITY;
         h.steps = 0;
     }
     float rgb[3], n[3];
-    shade_hit(job->tree, &job->shade, &h, dir, rgb, n);
+    shade_sample(sh, acc, &h, dir, i, j, 0, job->shade.ao_rays, job->shade.ao_rays, rgb, n);
     const size_t px = (size_t)j * job->cam->width + i;
     for (int a = 0; a < 3; a++)
         job->rgb[3 * px + (size_t)a] = srgb8_fast(rgb[a]);
@@ -104,17 +164,32 @@ static inline void render_pixel(const frame_job *job, uint32_t i, uint32_t j, co
     if (job->normals_f)
         for (int a = 0; a < 3; a++)
             job->normals_f[3 * px + (size_t)a] = h.hit ? n[a] : 0.0f;
-    *hits += (uint64_t)h.hit;
-    *steps += h.steps;
+    if (job->alpha)
+        job->alpha[px] = h.hit ? 255 : 0;
+    if (sh->probes) {
+        aa_probe *p = &sh->probes[px];
+        p->hit = (uint8_t)h.hit;
+        p->t = h.hit ? (float)h.t : INFINITY;
+        p->surface = h.hit && job->tree->surfaces ? job->tree->surfaces[h.voxel] : 0;
+        for (int a = 0; a < 3; a++)
+            p->n[a] = n[a];
+        float f = (float)t_lo; /* rounded down: a start never late */
+        if ((double)f > t_lo)
+            f = nextafterf(f, -INFINITY);
+        p->t_lo = f;
+    }
+    acc->hits += (uint64_t)h.hit;
+    acc->steps += h.steps;
 }
 
 /* The pixels [i0, i1) x [j0, j1): with the beam, each sub-block's rays are
  * traced from its start only, from its anchor, and none at all when its
  * pyramid touches no occupied cell. */
-static void render_block(const frame_job *job, const trace_eye *eye, const double *us, uint32_t us0,
-                         uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1, uint64_t *hits,
-                         uint64_t *steps)
+static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye *eye,
+                         const double *us, uint32_t us0, uint32_t i0, uint32_t i1, uint32_t j0,
+                         uint32_t j1)
 {
+    const frame_job *job = sh->job;
     const camera *cam = job->cam;
     beam_grid g;
     int any = 1;
@@ -129,11 +204,13 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
         g.t_lo[0][0] = 0.0;
     }
     if (!any) { /* every ray misses: shade one miss (no direction needed), copy it */
-        render_pixel(job, i0, j0, cam->forward, NULL, NULL, hits, steps);
+        render_pixel(sh, acc, i0, j0, cam->forward, NULL, NULL, INFINITY);
         const size_t p0 = (size_t)j0 * cam->width + i0, w = i1 - i0;
         uint8_t *row0 = job->rgb + 3 * p0;
         for (size_t k = 1; k < w; k++)
             memcpy(row0 + 3 * k, row0, 3);
+        for (size_t k = 1; sh->probes && k < w; k++)
+            sh->probes[p0 + k] = sh->probes[p0];
         for (uint32_t j = j0; j < j1; j++) {
             const size_t px = (size_t)j * cam->width + i0;
             if (j > j0)
@@ -145,6 +222,10 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
                 memset(job->normals + 3 * px, 0, 3 * w);
             if (job->normals_f)
                 memset(job->normals_f + 3 * px, 0, 3 * w * sizeof(float));
+            if (job->alpha)
+                memset(job->alpha + px, 0, w);
+            if (sh->probes)
+                memcpy(&sh->probes[px], &sh->probes[p0], w * sizeof *sh->probes);
         }
         return;
     }
@@ -154,7 +235,7 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
             if (!(t_lo < INFINITY)) { /* every ray of the sub-block misses: no direction */
                 for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++)
                     for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++)
-                        render_pixel(job, i, j, cam->forward, NULL, NULL, hits, steps);
+                        render_pixel(sh, acc, i, j, cam->forward, NULL, NULL, INFINITY);
                 continue;
             }
             /* the sub-block's rays all start at t_lo: where they do, the
@@ -176,15 +257,142 @@ static void render_block(const frame_job *job, const trace_eye *eye, const doubl
                     trace_ray r;
                     const int traced =
                         trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY);
-                    render_pixel(job, i, j, dir, traced ? &r : NULL, &an, hits, steps);
+                    render_pixel(sh, acc, i, j, dir, traced ? &r : NULL, &an, t_lo);
                 }
             }
         }
 }
 
-static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t *hits,
-                        uint64_t *steps)
+/* The first pixel of the beam block holding pixel k along an axis of n
+ * pixels, and its end. */
+static void block_span(const frame_job *job, uint32_t k, uint32_t n, uint32_t *k0, uint32_t *k1)
 {
+    const uint32_t bs = job->beam_size, t0 = k / FRAME_TILE * FRAME_TILE;
+    const uint32_t t1 = t0 + FRAME_TILE < n ? t0 + FRAME_TILE : n;
+    *k0 = t0 + (k - t0) / bs * bs;
+    *k1 = *k0 + bs < t1 ? *k0 + bs : t1;
+}
+
+/* Where the samples of pixel (i, j) may start (+inf: they all miss). Its
+ * square lies within the centre rays of the 3 x 3 pixels around it; when
+ * those are all in one beam block, their rays are in the block's pyramid,
+ * which its sub-blocks' pyramids tile, so no sample meets an occupied voxel
+ * before the least of those sub-blocks' starts (beam.h). Pixels at a
+ * block's border, and --beam 0, start at the eye. */
+static double sample_start(const frame_shared *sh, uint32_t i, uint32_t j)
+{
+    const frame_job *job = sh->job;
+    const camera *cam = job->cam;
+    if (!job->beam_size)
+        return 0.0;
+    uint32_t i0, i1, j0, j1;
+    block_span(job, i, cam->width, &i0, &i1);
+    block_span(job, j, cam->height, &j0, &j1);
+    if (i < i0 + 1 || i + 2 > i1 || j < j0 + 1 || j + 2 > j1)
+        return 0.0;
+    float lo = INFINITY;
+    for (uint32_t y = j - 1; y <= j + 1; y++)
+        for (uint32_t x = i - 1; x <= i + 1; x++) {
+            const float t = sh->probes[(size_t)y * cam->width + x].t_lo;
+            lo = t < lo ? t : lo;
+        }
+    return lo;
+}
+
+/* Sample k of pixel (i, j) (aa.h's order), traced from t_lo and shaded
+ * with AO rays k * per .. of per * N^2; its colour in rgb, what the edge
+ * test keeps of it in p. */
+static void trace_sample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
+                         uint32_t j, unsigned k, double t_lo, unsigned per, float rgb[3],
+                         aa_probe *p)
+{
+    const frame_job *job = sh->job;
+    const camera *cam = job->cam;
+    const unsigned na = job->aa;
+    const double w = (double)cam->width, hh = (double)cam->height;
+    double fx, fy, dir[3];
+    aa_sample_offset(na, k, &fx, &fy);
+    const double u = (2.0 * ((double)i + fx) / w - 1.0) * cam->h * w / hh;
+    const double v = (1.0 - 2.0 * ((double)j + fy) / hh) * cam->h;
+    camera_ray_uv(cam, u, v, dir);
+    trace_ray r;
+    trace_hit h;
+    if (t_lo < INFINITY && trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY)) {
+        sh->traverse(job->tree, &job->opts, &r, NULL, &h);
+    } else {
+        h.hit = 0;
+        h.t = INFINITY;
+        h.steps = 0;
+    }
+    acc->rays++;
+    acc->steps += h.steps;
+    shade_sample(sh, acc, &h, dir, i, j, k * per, per, per * na * na, rgb, p->n);
+    p->hit = (uint8_t)h.hit;
+    p->t = h.hit ? (float)h.t : INFINITY;
+    p->surface = h.hit && job->tree->surfaces ? job->tree->surfaces[h.voxel] : 0;
+}
+
+/* Pixel (i, j) again with samples (aa.h): the four corner samples of the
+ * N x N grid first; when they and the centre ray all agree by the edge
+ * rule, the pixel holds no edge and they are its colour; otherwise all
+ * N x N. Colours averaged in linear light; AO rays shared out. */
+static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
+                        uint32_t j)
+{
+    const frame_job *job = sh->job;
+    const camera *cam = job->cam;
+    const unsigned na = job->aa, ns = na * na, ao = job->shade.ao_rays;
+    const unsigned per = ao ? (ao / ns > 0 ? ao / ns : 1) : 0;
+    const size_t px = (size_t)j * cam->width + i;
+    const unsigned corner[4] = {0, na - 1, ns - na, ns - 1};
+    float sum[3] = {0.0f, 0.0f, 0.0f};
+    unsigned hits = 0, done = 0;
+    int uniform = 1;
+    const double t_lo = sample_start(sh, i, j);
+    for (unsigned k = 0; k < ns; k++) {
+        int is_corner = 0;
+        for (unsigned c = 0; c < 4; c++)
+            is_corner |= k == corner[c];
+        const int pass = done < 4 ? 0 : 1; /* corners, then the rest */
+        if (pass == 0 ? !is_corner : is_corner)
+            continue;
+        float rgb[3];
+        aa_probe p;
+        trace_sample(sh, acc, eye, i, j, k, t_lo, per, rgb, &p);
+        uniform &= !aa_differs(&p, &sh->probes[px]);
+        hits += p.hit;
+        if (p.hit || !job->alpha)
+            for (int a = 0; a < 3; a++)
+                sum[a] += rgb[a];
+        if (++done == 4) {
+            if (uniform)
+                break;
+            k = (unsigned)-1; /* the rest, from the start */
+        }
+    }
+    const float div = job->alpha ? (float)(hits ? hits : 1) : (float)done;
+    for (int a = 0; a < 3; a++)
+        job->rgb[3 * px + (size_t)a] = srgb8_fast(sum[a] / div);
+    if (job->alpha)
+        job->alpha[px] = (uint8_t)((hits * 255u + done / 2) / done);
+    acc->aa_pixels++;
+    acc->aa_full += done == ns;
+}
+
+/* The antialiasing pass over [i0, i1) x [j0, j1): samples where needed. */
+static void supersample_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye,
+                             uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+{
+    const camera *cam = sh->job->cam;
+    for (uint32_t j = j0; j < j1; j++)
+        for (uint32_t i = i0; i < i1; i++)
+            if (aa_needs(sh->probes, cam->width, cam->height, i, j))
+                supersample(sh, acc, eye, i, j);
+}
+
+static void render_tile(const frame_shared *sh, frame_acc *acc, uint32_t tx, uint32_t ty)
+{
+    const frame_job *job = sh->job;
     const camera *cam = job->cam;
     const uint32_t i0 = tx * FRAME_TILE, j0 = ty * FRAME_TILE;
     const uint32_t i1 = i0 + FRAME_TILE < cam->width ? i0 + FRAME_TILE : cam->width;
@@ -193,34 +401,50 @@ static void render_tile(const frame_job *job, uint32_t tx, uint32_t ty, uint64_t
     double us[FRAME_TILE]; /* camera_u of column i0 + k */
     trace_eye eye;
     trace_eye_init(job->tree, cam->eye, &eye); /* eye.ok = 0: every ray misses */
+    if (sh->phase == 1) {
+        supersample_tile(sh, acc, &eye, i0, i1, j0, j1);
+        return;
+    }
     for (uint32_t i = i0; i < i1; i++)
         us[i - i0] = camera_u(cam, i);
     for (uint32_t bj = j0; bj < j1; bj += bs)
         for (uint32_t bi = i0; bi < i1; bi += bs)
-            render_block(job, &eye, us, i0, bi, bi + bs < i1 ? bi + bs : i1, bj,
-                         bj + bs < j1 ? bj + bs : j1, hits, steps);
+            render_block(sh, acc, &eye, us, i0, bi, bi + bs < i1 ? bi + bs : i1, bj,
+                         bj + bs < j1 ? bj + bs : j1);
 }
 
 static void work(frame_shared *sh, int caller)
 {
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
-    uint64_t hits = 0, steps = 0;
+    frame_acc acc;
+    memset(&acc, 0, sizeof acc);
+    const double t0 = sh->job->timing ? now_ns() : 0.0;
     for (;;) {
         if (atomic_load_explicit(&sh->changed, memory_order_relaxed))
             break; /* another thread met the file changing: stop */
         uint64_t t = atomic_fetch_add(&sh->next, 1);
         if (t >= total)
             break;
-        render_tile(sh->job, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x), &hits,
-                    &steps);
+        render_tile(sh, &acc, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x));
         uint64_t d = atomic_fetch_add(&sh->done, 1) + 1;
-        if (caller && sh->job->progress)
+        if (caller && sh->phase == 0 && sh->job->progress)
             sh->job->progress(sh->job->progress_ctx, d, total);
-        if (caller)
+        if (caller && sh->phase == 0)
             test_hooks_tile(d);
     }
-    atomic_fetch_add(&sh->hits, hits);
-    atomic_fetch_add(&sh->steps, steps);
+    const double ns = sh->job->timing ? now_ns() - t0 : 0.0;
+    pthread_mutex_lock(&sh->lock);
+    sh->sum.rays += acc.rays;
+    sh->sum.hits += acc.hits;
+    sh->sum.steps += acc.steps;
+    sh->sum.aa_pixels += acc.aa_pixels;
+    sh->sum.aa_full += acc.aa_full;
+    sh->sum.shadow_rays += acc.shadow_rays;
+    sh->sum.ao_rays += acc.ao_rays;
+    sh->sum.secondary_steps += acc.secondary_steps;
+    sh->sum.secondary_ns += acc.secondary_ns;
+    sh->thread_ns += ns;
+    pthread_mutex_unlock(&sh->lock);
 }
 
 typedef struct work_arg {
@@ -249,36 +473,70 @@ static void *worker(void *arg)
     return NULL;
 }
 
-int frame_render(const frame_job *job, frame_stats *stats)
+/* One pass over every tile on job->threads threads. Returns 0 or the errno
+ * of a thread that could not be started (the pass is then done by fewer). */
+static int run_pass(frame_shared *sh, int phase)
 {
-    pthread_once(&srgb_once, srgb_init);
-    frame_shared sh;
-    sh.job = job;
-    sh.tiles_x = (job->cam->width + FRAME_TILE - 1) / FRAME_TILE;
-    sh.tiles_y = (job->cam->height + FRAME_TILE - 1) / FRAME_TILE;
-    atomic_init(&sh.next, 0);
-    atomic_init(&sh.done, 0);
-    atomic_init(&sh.hits, 0);
-    atomic_init(&sh.steps, 0);
-    atomic_init(&sh.changed, 0);
-    unsigned extra = job->threads > 1 ? job->threads - 1 : 0;
+    sh->phase = phase;
+    atomic_store(&sh->next, 0);
+    atomic_store(&sh->done, 0);
+    unsigned extra = sh->job->threads > 1 ? sh->job->threads - 1 : 0;
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;
     int rc = 0;
     unsigned started = 0;
     if (extra && !tid)
         rc = ENOMEM; /* render on this thread alone */
     for (; tid && started < extra; started++) {
-        rc = pthread_create(&tid[started], NULL, worker, &sh);
+        rc = pthread_create(&tid[started], NULL, worker, sh);
         if (rc != 0)
             break;
     }
-    guarded_work(&sh, 1);
+    guarded_work(sh, 1);
     for (unsigned k = 0; k < started; k++)
         pthread_join(tid[k], NULL);
     free(tid);
-    stats->rays = (uint64_t)job->cam->width * job->cam->height;
-    stats->hits = atomic_load(&sh.hits);
-    stats->steps = atomic_load(&sh.steps);
-    stats->file_changed = atomic_load(&sh.changed);
     return rc;
+}
+
+int frame_render(const frame_job *job, frame_stats *stats)
+{
+    pthread_once(&srgb_once, srgb_init);
+    frame_shared sh;
+    memset(&sh, 0, sizeof sh);
+    sh.job = job;
+    sh.traverse = job->traverse ? job->traverse : trace_impls[0].traverse;
+    sh.tiles_x = (job->cam->width + FRAME_TILE - 1) / FRAME_TILE;
+    sh.tiles_y = (job->cam->height + FRAME_TILE - 1) / FRAME_TILE;
+    atomic_init(&sh.next, 0);
+    atomic_init(&sh.done, 0);
+    atomic_init(&sh.changed, 0);
+    pthread_mutex_init(&sh.lock, NULL);
+    const size_t npx = (size_t)job->cam->width * job->cam->height;
+    int rc = 0;
+    if (job->aa > 1) {
+        sh.probes = calloc(npx, sizeof *sh.probes);
+        if (!sh.probes)
+            rc = ENOMEM; /* one ray a pixel */
+    }
+    int rc1 = run_pass(&sh, 0);
+    if (sh.probes && !atomic_load(&sh.changed)) {
+        int rc2 = run_pass(&sh, 1);
+        if (!rc1)
+            rc1 = rc2;
+    }
+    free(sh.probes);
+    pthread_mutex_destroy(&sh.lock);
+    memset(stats, 0, sizeof *stats);
+    stats->rays = (uint64_t)npx + sh.sum.rays;
+    stats->hits = sh.sum.hits;
+    stats->steps = sh.sum.steps;
+    stats->aa_pixels = sh.sum.aa_pixels;
+    stats->aa_full = sh.sum.aa_full;
+    stats->shadow_rays = sh.sum.shadow_rays;
+    stats->ao_rays = sh.sum.ao_rays;
+    stats->secondary_steps = sh.sum.secondary_steps;
+    stats->secondary_ns = sh.sum.secondary_ns;
+    stats->primary_ns = sh.thread_ns - sh.sum.secondary_ns;
+    stats->file_changed = atomic_load(&sh.changed);
+    return rc ? rc : rc1;
 }

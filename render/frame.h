@@ -9,8 +9,10 @@
 
 #include "common/view/camera.h"
 #include "format/oct.h"
+#include "render/aa.h"
 #include "render/shade.h"
 #include "render/trace.h"
+#include "render/trace_impl.h"
 
 #define FRAME_TILE 32 /* pixels a tile side */
 #define FRAME_BEAM_DEFAULT 32 /* beam block side: fewest instructions measured (docs/perf-log.md) */
@@ -27,6 +29,13 @@ typedef struct frame_job {
     unsigned threads;   /* >= 1 */
     unsigned beam_size; /* pixel block side of the beam test (beam.h), 1..FRAME_TILE;
                            0: every ray traced whole */
+    unsigned aa;        /* 2..AA_MAX: N x N samples for the pixels that need them
+                           (aa.h); 0 or 1: one ray a pixel */
+    uint8_t *alpha;     /* width*height coverage bytes (255 * hit samples / samples,
+                           rounded), or NULL; with it, rgb is the covered part's
+                           colour (straight alpha) and misses are black */
+    trace_traverse_fn traverse; /* NULL: the build's preferred implementation */
+    int timing;         /* 1: time the secondary rays apart (frame_stats) */
     /* Called by the calling thread after each tile it finishes, with tiles
      * done so far and the total; may be NULL. */
     void (*progress)(void *ctx, uint64_t done, uint64_t total);
@@ -34,7 +43,13 @@ typedef struct frame_job {
 } frame_job;
 
 typedef struct frame_stats {
-    uint64_t rays, hits, steps; /* steps: DDA steps, all rays */
+    uint64_t rays, hits, steps; /* primary rays (centre rays and samples), centre rays
+                                   that hit, their DDA steps */
+    uint64_t aa_pixels;         /* pixels traced again with samples (the edge test) */
+    uint64_t aa_full;           /* of those, with all N x N (their corners disagreed) */
+    uint64_t shadow_rays, ao_rays, secondary_steps;
+    double primary_ns, secondary_ns; /* with job->timing: thread time summed over
+                                        threads, spent on each kind of ray */
     int file_changed; /* the mapped file changed under a thread (map_guard.h): image incomplete */
 } frame_stats;
 

@@ -17,19 +17,24 @@
 #include "common/test_hooks.h"
 #include "common/version.h"
 #include "format/oct.h"
+#include "render/aa.h"
+#include "render/ao.h"
 #include "render/frame.h"
+#include "render/framing.h"
 #include "render/map_guard.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/views.h"
 
+_Static_assert(VIEWS_AA_MAX == AA_MAX && VIEWS_AO_MAX == AO_MAX_RAYS, "views limits");
 #define RENDER_MAX_PARTS 100000 /* --part I/N: N at most the largest --orbit */
 
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
     "              [--split K] [--refine] [--light X,Y,Z] [--background R,G,B]\n"
-    "              [--beam N] [--threads N] [--trust] [--info] [-q]\n"
+    "              [--aa N] [--alpha] [--shadows] [--ao N]\n"
+    "              [--beam N] [--threads N] [--trust] [--info] [-q] [-v]\n"
     "       render FILE.oct --views VIEWS_FILE [--part I/N] [options]\n"
     "       render FILE.oct -o 'frame_%04d.png' --orbit N [--part I/N] [options]\n"
     "       render --info FILE.oct\n";
@@ -39,7 +44,7 @@ static const char help_text[] =
     "Ray traces the voxels of FILE.oct (two-step discrete ray tracing).\n"
     "  -o OUT.png          colour image (8-bit sRGB PNG)\n"
     "  --size WxH          image size in pixels (default 512x512, each 1.." LIMIT_STR(CAMERA_MAX_SIZE) ")\n"
-    "  --eye, --target     camera position and aim (default: a view framing the cube)\n"
+    "  --eye, --target     camera position and aim (default: a view framing the occupied voxels)\n"
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
     "  --fov DEG           vertical field of view, in (0, 180) (default 30)\n"
     "  --depth OUT.pfm     distance along each pixel's unit ray (PFM, +inf on miss)\n"
@@ -50,6 +55,12 @@ static const char help_text[] =
     "  --beam N            walk N x N pixel blocks (and their 4 x 4 sub-blocks) as\n"
     "                      pyramids first, to skip what no ray of them can hit\n"
     "                      (default 32; 0: off; same image)\n"
+    "  --aa N              up to N x N samples for a pixel whose centre ray differs from\n"
+    "                      a neighbour's, 1.." LIMIT_STR(VIEWS_AA_MAX) " (default 1: one ray a pixel)\n"
+    "  --alpha             RGBA PNG, alpha = the fraction of the pixel's samples that hit\n"
+    "  --shadows           one shadow ray per lit hit towards --light\n"
+    "  --ao N              ambient occlusion: N rays over each hit's hemisphere, up to\n"
+    "                      1/8 of the cube's edge, 0.." LIMIT_STR(VIEWS_AO_MAX) " (default 0: off)\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
     "  --background R,G,B  linear colour of rays that miss, 0..1 each (default 0,0,0)\n"
     "  --threads N         worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: online CPUs, at most "
@@ -64,6 +75,7 @@ static const char help_text[] =
     "  --info              print a summary of FILE.oct (format version, flags,\n"
     "                      tree, stored function, shard fields)\n"
     "  -q                  no per-view timing lines\n"
+    "  -v                  per-view line with Mrays/s of each kind of ray\n"
     "  --version           print the version and exit\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
@@ -135,34 +147,13 @@ static int is_pfm(const char *path)
     return n >= 4 && strcmp(path + n - 4, ".pfm") == 0;
 }
 
-/* A view that frames the root cube: aim at its centre from the direction of
- * the benchmark view, far enough that its bounding sphere fits the fov. */
-static void frame_cube(const oct_tree *t, views_view *v)
-{
-    double c[3];
-    for (int a = 0; a < 3; a++)
-        c[a] = t->origin[a] + 0.5 * t->edge;
-    if (!v->has_target)
-        memcpy(v->target, c, sizeof c);
-    if (!v->has_eye) {
-        static const double dir[3] = {1.7, 1.1, 1.4};
-        double n = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-        double h = tan(v->fov * M_PI / 360.0);
-        if (v->width < v->height)
-            h = h * (double)v->width / (double)v->height;
-        double dist = 1.05 * (0.5 * sqrt(3.0) * t->edge) / sin(atan(h));
-        for (int a = 0; a < 3; a++)
-            v->eye[a] = v->target[a] + dist * dir[a] / n;
-    }
-}
-
 /* The command line. */
 typedef struct render_args {
     views_view base; /* the command line's view options */
     const char *oct_path, *views_path;
     long orbit, split, threads, beam;
     long part_index, part_count; /* --part I/N; count 0: every view */
-    int refine, info, quiet, trust;
+    int refine, info, quiet, trust, verbose;
     double light[3], bg[3];
     int has_light;
 } render_args;
@@ -191,8 +182,10 @@ static int parse_value_option(render_args *o, const char *a, const char *val)
     } else if (strcmp(a, "--light") == 0) {
         e = parse_vec3(val, o->light);
         o->has_light = 1;
-        if (e == PARSE_OK && o->light[0] == 0 && o->light[1] == 0 && o->light[2] == 0)
-            return diag_usage_error(usage_text, "--light: %s: must not be the zero vector", val);
+        shade_params sp;
+        if (e == PARSE_OK && shade_set_light(&sp, o->light) != 0)
+            return diag_usage_error(usage_text, "--light: %s: must be a finite, non-zero vector",
+                                    val);
     } else if (strcmp(a, "--background") == 0) {
         e = parse_vec3(val, o->bg);
         for (int k = 0; k < 3 && e == PARSE_OK; k++)
@@ -221,6 +214,9 @@ static int check_args(const render_args *o)
     if (o->orbit && views_check_pattern(o->base.out) != 0)
         return diag_usage_error(usage_text, "--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
                            o->base.out);
+    char msg[512];
+    if (!o->views_path && views_check(&o->base, msg, sizeof msg) != 0)
+        return diag_usage_error(usage_text, "%s", msg);
     if (o->part_count && !o->views_path && !o->orbit)
         return diag_usage_error(usage_text, "%s", "--part needs --views or --orbit");
     if (o->orbit && (o->base.depth || o->base.normals))
@@ -258,11 +254,14 @@ static int parse_args(int argc, char **argv, render_args *o)
                     : strcmp(a, "--info") == 0 ? &o->info
                     : strcmp(a, "--trust") == 0 ? &o->trust
                     : strcmp(a, "-q") == 0     ? &o->quiet
+                    : strcmp(a, "-v") == 0     ? &o->verbose
                                                : NULL;
         if (flag) {
             *flag = 1;
             continue;
         }
+        if (views_flag(&o->base, a))
+            continue;
         int known = views_is_option(a) || strcmp(a, "--views") == 0 ||
                     strcmp(a, "--orbit") == 0 || strcmp(a, "--split") == 0 || strcmp(a, "--part") == 0 ||
                     strcmp(a, "--light") == 0 || strcmp(a, "--background") == 0 ||
@@ -332,7 +331,7 @@ static int open_tree(const render_args *o, oct_file **file)
 static int command_line_views(const oct_tree *tree, const render_args *o, views_view *base,
                               views_view **list, size_t *nviews)
 {
-    frame_cube(tree, base);
+    framing_default_view(tree, base);
     if (o->orbit) {
         *list = views_orbit(base, (unsigned)o->orbit, base->out);
         if (!*list)
@@ -352,7 +351,7 @@ static int command_line_views(const oct_tree *tree, const render_args *o, views_
 
 /* The image buffers, each as large as the largest view needs. */
 typedef struct render_buffers {
-    uint8_t *rgb, *nrm;
+    uint8_t *rgb, *nrm, *alpha;
     float *depth, *nrm_f;
 } render_buffers;
 
@@ -369,7 +368,7 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     }
     size_t max_px = 0;
     for (size_t k = 0; k < nviews; k++) {
-        frame_cube(tree, &list[k]);
+        framing_default_view(tree, &list[k]);
         camera_err ce = camera_init(&(*cams)[k], list[k].eye, list[k].target, list[k].up,
                                     list[k].fov, list[k].width, list[k].height);
         if (ce != CAMERA_OK) {
@@ -390,8 +389,9 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     if (status != EXIT_OK)
         return status;
     buf->rgb = malloc(max_px * 3);
-    int want_depth = 0, want_nrm = 0, want_nrm_f = 0;
+    int want_depth = 0, want_nrm = 0, want_nrm_f = 0, want_alpha = 0;
     for (size_t k = 0; k < nviews; k++) {
+        want_alpha |= list[k].alpha;
         want_depth |= list[k].depth != NULL;
         want_nrm |= list[k].normals != NULL && !is_pfm(list[k].normals);
         want_nrm_f |= list[k].normals != NULL && is_pfm(list[k].normals);
@@ -402,12 +402,39 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
         buf->nrm = malloc(max_px * 3);
     if (want_nrm_f)
         buf->nrm_f = malloc(max_px * 3 * sizeof *buf->nrm_f);
+    if (want_alpha)
+        buf->alpha = malloc(max_px);
     if (!buf->rgb || (want_depth && !buf->depth) || (want_nrm && !buf->nrm) ||
-        (want_nrm_f && !buf->nrm_f)) {
+        (want_nrm_f && !buf->nrm_f) || (want_alpha && !buf->alpha)) {
         diag_error("out of memory for a %zu-pixel image", max_px);
         return EXIT_RUNTIME;
     }
     return EXIT_OK;
+}
+
+/* The per-view line: size, time, rate, hits; the supersampled share with
+ * --aa; with -v the rays of each kind and their rates (thread time). */
+static void report_view(const render_args *o, const views_view *v, const frame_stats *st,
+                        double ms)
+{
+    const uint64_t px = (uint64_t)v->width * (uint64_t)v->height;
+    fprintf(stderr, "render: %s: %ldx%ld, %.1f ms, %.2f Mrays/s, %.1f%% hit", v->out, v->width,
+            v->height, ms, ms > 0 ? (double)st->rays / ms / 1e3 : 0.0,
+            100.0 * (double)st->hits / (double)px);
+    if (v->aa > 1)
+        fprintf(stderr, ", %.2f%% edge pixels, %.2f%% supersampled",
+                100.0 * (double)st->aa_pixels / (double)px, 100.0 * (double)st->aa_full / (double)px);
+    if (o->verbose) {
+        const double th = (double)o->threads;
+        fprintf(stderr, "; primary %.2f Mrays %.2f Mrays/s", (double)st->rays / 1e6,
+                st->primary_ns > 0 ? (double)st->rays * th / st->primary_ns * 1e3 : 0.0);
+        const double sec = (double)(st->shadow_rays + st->ao_rays);
+        if (sec > 0)
+            fprintf(stderr, ", shadow %.2f Mrays, ao %.2f Mrays, %.2f Mrays/s",
+                    (double)st->shadow_rays / 1e6, (double)st->ao_rays / 1e6,
+                    st->secondary_ns > 0 ? sec * th / st->secondary_ns * 1e3 : 0.0);
+    }
+    fputc('\n', stderr);
 }
 
 /* Renders one view and writes its images; adds its time and rays to the
@@ -435,11 +462,18 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     job.normals_f = v->normals && is_pfm(v->normals) ? buf->nrm_f : NULL;
     job.threads = (unsigned)o->threads;
     job.beam_size = (unsigned)o->beam;
+    job.aa = (unsigned)v->aa;
+    job.alpha = v->alpha ? buf->alpha : NULL;
+    job.shade.shadows = v->shadows;
+    job.shade.ao_rays = (unsigned)v->ao;
+    job.timing = o->verbose;
     if (!o->quiet && diag_stderr_is_tty())
         job.progress = progress_bar;
     frame_stats st;
     double t0 = now_ms();
-    frame_render(&job, &st);
+    const int rc = frame_render(&job, &st);
+    if (rc != 0) /* fewer threads, or (out of memory for --aa) one ray a pixel */
+        fprintf(stderr, "render: %s: %s: rendered with what could be had\n", v->out, strerror(rc));
     double ms = now_ms() - t0;
     if (st.file_changed || map_guard_changed()) { /* before any output of this view */
         diag_path_error(o->oct_path, "changed while being read");
@@ -449,7 +483,8 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     *total_rays += st.rays;
     const char *op = NULL;
     const uint32_t w = (uint32_t)v->width, h = (uint32_t)v->height;
-    if (image_write_png(v->out, buf->rgb, w, h, &op) != 0) {
+    if ((v->alpha ? image_write_png_alpha(v->out, buf->rgb, buf->alpha, w, h, &op)
+                  : image_write_png(v->out, buf->rgb, w, h, &op)) != 0) {
         diag_path_error(v->out, "%s: %s", op ? op : "write", strerror(errno));
         return EXIT_RUNTIME;
     }
@@ -464,9 +499,7 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
         return EXIT_RUNTIME;
     }
     if (!o->quiet)
-        fprintf(stderr, "render: %s: %ux%u, %.1f ms, %.2f Mrays/s, %.1f%% hit\n", v->out, w, h,
-                ms, ms > 0 ? (double)st.rays / ms / 1e3 : 0.0,
-                100.0 * (double)st.hits / (double)st.rays);
+        report_view(o, v, &st, ms);
     return EXIT_OK;
 }
 
@@ -512,7 +545,7 @@ int main(int argc, char **argv)
     char *views_text = NULL;
     views_view *list = NULL;
     size_t nviews = 0;
-    render_buffers buf = {NULL, NULL, NULL, NULL};
+    render_buffers buf = {NULL, NULL, NULL, NULL, NULL};
     camera *cams = NULL;
     oct_file *file = NULL;
 
@@ -561,6 +594,7 @@ done:
     free(buf.depth);
     free(buf.nrm);
     free(buf.nrm_f);
+    free(buf.alpha);
     free(cams);
     free(list);
     free(views_text);

@@ -18,22 +18,25 @@ void shade_default_light(const camera *cam, double light[3])
 int shade_set_light(shade_params *p, const double light[3])
 {
     double n = sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
-    if (!(n > 0.0) || !isfinite(n))
-        return -1;
+    if (!(n > 0.0) || !isfinite(n)) {
+        /* zero, NaN or infinite; or finite but its square overflows: scaled first */
+        double m = fmax(fabs(light[0]), fmax(fabs(light[1]), fabs(light[2])));
+        if (!(m > 0.0) || !isfinite(m) || isnan(light[0] + light[1] + light[2]))
+            return -1;
+        double l[3] = {light[0] / m, light[1] / m, light[2] / m};
+        return shade_set_light(p, l);
+    }
     for (int a = 0; a < 3; a++)
         p->light[a] = light[a] / n;
     return 0;
 }
 
-void shade_hit(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
-               const double dir[3], float rgb[3], float n[3])
+double shade_normal(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
+                    const double dir[3], float n[3])
 {
     if (!hit->hit) {
-        for (int a = 0; a < 3; a++) {
-            rgb[a] = p->background[a];
-            n[a] = 0.0f;
-        }
-        return;
+        n[0] = n[1] = n[2] = 0.0f;
+        return 0.0;
     }
     uint32_t rec = tree->voxels[hit->voxel];
     oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
@@ -42,13 +45,28 @@ void shade_hit(const oct_tree *tree, const shade_params *p, const trace_hit *hit
         for (int a = 0; a < 3; a++)
             n[a] = -n[a];
     double lam = n[0] * p->light[0] + n[1] * p->light[1] + n[2] * p->light[2];
-    if (lam < 0.0)
-        lam = 0.0;
+    return lam < 0.0 ? 0.0 : lam;
+}
+
+void shade_color(const oct_tree *tree, const shade_params *p, const trace_hit *hit, double lam,
+                 float ao, float rgb[3])
+{
+    if (!hit->hit) {
+        for (int a = 0; a < 3; a++)
+            rgb[a] = p->background[a];
+        return;
+    }
     unsigned s = tree->surfaces ? tree->surfaces[hit->voxel] : 0;
     if (s >= tree->surface_count)
         s = 0;
     const float *col = tree->palette + 3 * s;
-    float k = p->ambient + (1.0f - p->ambient) * (float)lam;
+    float k = p->ambient * ao + (1.0f - p->ambient) * (float)lam;
     for (int a = 0; a < 3; a++)
         rgb[a] = col[a] * k;
+}
+
+void shade_hit(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
+               const double dir[3], float rgb[3], float n[3])
+{
+    shade_color(tree, p, hit, shade_normal(tree, p, hit, dir, n), 1.0f, rgb);
 }

@@ -1,5 +1,7 @@
 /* shade: two-sided Lambert + ambient shading of a traced hit, one
- * directional light, the surface's palette colour; normal-as-colour. */
+ * directional light, the surface's palette colour; normal-as-colour. The
+ * light's visibility (shadows) and the ambient's (ambient occlusion) come
+ * from the caller (render/shadow.h, render/ao.h). */
 #ifndef SHADE_H
 #define SHADE_H
 
@@ -11,6 +13,8 @@ typedef struct shade_params {
     double light[3];      /* unit vector from the surface towards the light */
     float background[3];  /* linear RGB of rays that miss */
     float ambient;        /* 0..1, share of the colour lit regardless of the light */
+    int shadows;          /* 1: one shadow ray per lit hit (render/shadow.h) */
+    unsigned ao_rays;     /* ambient occlusion rays per hit (render/ao.h); 0: none */
 } shade_params;
 
 /* The default light: from over the viewer's (left) shoulder. */
@@ -20,8 +24,19 @@ void shade_default_light(const camera *cam, double light[3]);
  * finite. */
 int shade_set_light(shade_params *p, const double light[3]);
 
-/* Linear RGB of the hit seen along unit `dir`, in rgb[3]; the normal turned to
- * face the viewer in n[3] (zero vector on a miss). */
+/* The normal of the hit turned to face the viewer (seen along unit `dir`)
+ * in n[3], and the Lambert term max(0, n . light) it gets; a miss gives the
+ * zero vector and 0. */
+double shade_normal(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
+                    const double dir[3], float n[3]);
+
+/* Linear RGB of a hit with Lambert term `lam` (shade_normal's, times the
+ * light's visibility) and ambient visibility `ao` (1: open), in rgb[3];
+ * the background on a miss. */
+void shade_color(const oct_tree *tree, const shade_params *p, const trace_hit *hit, double lam,
+                 float ao, float rgb[3]);
+
+/* shade_normal and shade_color with the light and the ambient unblocked. */
 void shade_hit(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
                const double dir[3], float rgb[3], float n[3]);
 

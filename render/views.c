@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "common/view/camera.h"
 #include "common/limits.h"
@@ -18,16 +19,41 @@ void views_defaults(views_view *v)
     v->fov = 30.0;
     v->width = 512;
     v->height = 512;
+    v->aa = 1;
 }
 
 static const char *const value_opts[] = {"-o", "--eye", "--target", "--up", "--fov",
-                                         "--size", "--depth", "--normals"};
+                                         "--size", "--depth", "--normals", "--aa", "--ao"};
 
 int views_is_option(const char *name)
 {
     for (size_t i = 0; i < sizeof value_opts / sizeof value_opts[0]; i++)
         if (strcmp(name, value_opts[i]) == 0)
             return 1;
+    return 0;
+}
+
+int views_flag(views_view *v, const char *name)
+{
+    int *f = NULL, dummy = 0;
+    if (strcmp(name, "--alpha") == 0)
+        f = v ? &v->alpha : &dummy;
+    else if (strcmp(name, "--shadows") == 0)
+        f = v ? &v->shadows : &dummy;
+    if (!f)
+        return 0;
+    *f = 1;
+    return 1;
+}
+
+int views_check(const views_view *v, char *msg, size_t n)
+{
+    size_t len = v->out ? strlen(v->out) : 0;
+    if (v->alpha && !(len >= 4 && strcasecmp(v->out + len - 4, ".png") == 0)) {
+        snprintf(msg, n, "--alpha: '%s': the output must be a PNG (name ending in .png)",
+                 v->out ? v->out : "");
+        return -1;
+    }
     return 0;
 }
 
@@ -56,6 +82,10 @@ int views_apply(views_view *v, const char *name, const char *value, char *msg, s
         }
     } else if (strcmp(name, "--size") == 0) {
         e = parse_size(value, CAMERA_MAX_SIZE, &v->width, &v->height);
+    } else if (strcmp(name, "--aa") == 0) {
+        e = parse_long(value, 1, VIEWS_AA_MAX, &v->aa);
+    } else if (strcmp(name, "--ao") == 0) {
+        e = parse_long(value, 0, VIEWS_AO_MAX, &v->ao);
     } else {
         snprintf(msg, n, "unknown option '%s'", name);
         return -1;
@@ -67,7 +97,10 @@ int views_apply(views_view *v, const char *name, const char *value, char *msg, s
     }
     if (e != PARSE_OK) {
         snprintf(msg, n, "%s: '%s': %s%s", name, value, parse_strerror(e),
-                 strcmp(name, "--size") == 0 ? " (WxH, 1.." LIMIT_STR(CAMERA_MAX_SIZE) " each)" : "");
+                 strcmp(name, "--size") == 0  ? " (WxH, 1.." LIMIT_STR(CAMERA_MAX_SIZE) " each)"
+                 : strcmp(name, "--aa") == 0 ? " (1.." LIMIT_STR(VIEWS_AA_MAX) ")"
+                 : strcmp(name, "--ao") == 0 ? " (0.." LIMIT_STR(VIEWS_AO_MAX) ")"
+                                             : "");
         return -1;
     }
     return 0;
@@ -99,6 +132,8 @@ int views_parse(char *text, const views_view *base, views_view **out, size_t *co
         for (char *tok = strtok_r(line, " \t\r\v\f", &save); tok;
              tok = strtok_r(NULL, " \t\r\v\f", &save)) {
             any = 1;
+            if (views_flag(&v, tok))
+                continue;
             if (!views_is_option(tok)) {
                 snprintf(msg, sizeof msg, "unknown option '%s'", tok);
                 line_bad = 1;
@@ -119,6 +154,8 @@ int views_parse(char *text, const views_view *base, views_view **out, size_t *co
             snprintf(msg, sizeof msg, "a view needs -o OUT.png");
             line_bad = 1;
         }
+        if (any && !line_bad && views_check(&v, msg, sizeof msg) != 0)
+            line_bad = 1;
         if (line_bad) {
             bad = 1;
             if (report)

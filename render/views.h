@@ -6,6 +6,7 @@
  * value syntax as the command line:
  *     -o OUT.png [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z] [--fov DEG]
  *     [--size WxH] [--depth OUT.pfm] [--normals OUT.png]
+ *     [--aa N] [--ao N] [--alpha] [--shadows]
  * Options a line leaves out take the command line's values (or the
  * defaults). Paths cannot contain whitespace or '#'. Every line needs -o.
  * Relative paths are taken as they are (relative to the working directory). */
@@ -22,8 +23,14 @@ typedef struct views_view {
     const char *out;     /* PNG path (required) */
     const char *depth;   /* PFM path or NULL */
     const char *normals; /* PNG path or NULL */
+    long aa;             /* 1..VIEWS_AA_MAX samples a side where needed */
+    long ao;             /* ambient occlusion rays, 0..VIEWS_AO_MAX */
+    int alpha, shadows;  /* flags */
     unsigned line;       /* views-file line (1-based), 0 for the command line */
 } views_view;
+
+#define VIEWS_AA_MAX 16    /* render/aa.h's AA_MAX */
+#define VIEWS_AO_MAX 4096  /* render/ao.h's AO_MAX_RAYS */
 
 /* The built-in defaults: 512x512, up 0,0,1, fov 30; eye and target unset
  * (the caller frames the cube); no outputs. */
@@ -31,6 +38,14 @@ void views_defaults(views_view *v);
 
 /* 1 when `name` is a per-view option that takes a value. */
 int views_is_option(const char *name);
+
+/* 1 when `name` is a per-view flag (no value): --alpha, --shadows; sets it
+ * in v when v is not NULL. */
+int views_flag(views_view *v, const char *name);
+
+/* A view's outputs that cannot work together (--alpha needs a .png output).
+ * Returns 0, or -1 with a message in msg (size n). */
+int views_check(const views_view *v, char *msg, size_t n);
 
 /* Applies option `name` with `value` to v. `value` must outlive v (paths
  * are not copied). Returns 0, or -1 with a message in msg (size n). */

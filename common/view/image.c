@@ -5,6 +5,7 @@
 #include <math.h>
 #include <png.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <zlib.h>
 
@@ -53,17 +54,12 @@ static void png_flush_cb(png_structp png)
     (void)png;
 }
 
-int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h,
-                    const char **failed_op)
+/* RGB, or RGBA when alpha is not NULL (each row interleaved in `row`,
+ * 4 * w bytes). */
+static int write_png(const char *path, const uint8_t *rgb, const uint8_t *alpha, uint8_t *row,
+                     uint32_t w, uint32_t h, const char **failed_op)
 {
     const char *op = "open";
-    size_t bytes;
-    if (image_rgb_size(w, h, &bytes) != 0 || w > PNG_UINT_31_MAX || h > PNG_UINT_31_MAX) {
-        errno = EOVERFLOW;
-        if (failed_op)
-            *failed_op = "size";
-        return -1;
-    }
     atomic_file *af = atomic_file_open(path);
     if (!af) {
         if (failed_op)
@@ -86,7 +82,8 @@ int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h
     }
     errno = 0;
     png_set_write_fn(png, af, png_write_cb, png_flush_cb);
-    png_set_IHDR(png, info, w, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+    png_set_IHDR(png, info, w, h, 8, alpha ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     /* Rendered frames are flat background and smooth shading: the SUB filter
@@ -96,8 +93,18 @@ int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h
     png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
     png_set_compression_strategy(png, Z_RLE);
     png_write_info(png, info);
-    for (uint32_t j = 0; j < h; j++)
-        png_write_row(png, rgb + (size_t)j * w * 3);
+    for (uint32_t j = 0; j < h; j++) {
+        const uint8_t *src = rgb + (size_t)j * w * 3;
+        if (!alpha) {
+            png_write_row(png, src);
+            continue;
+        }
+        for (uint32_t i = 0; i < w; i++) {
+            memcpy(row + 4 * (size_t)i, src + 3 * (size_t)i, 3);
+            row[4 * (size_t)i + 3] = alpha[(size_t)j * w + i];
+        }
+        png_write_row(png, row);
+    }
     png_write_end(png, info);
     png_destroy_write_struct(&png, &info);
     if (atomic_file_commit(af, failed_op) != 0)
@@ -111,6 +118,45 @@ fail:
     if (failed_op)
         *failed_op = op;
     return -1;
+}
+
+static int png_size_ok(uint32_t w, uint32_t h, const char **failed_op)
+{
+    size_t bytes;
+    if (image_rgb_size(w, h, &bytes) != 0 || w > PNG_UINT_31_MAX / 4 || h > PNG_UINT_31_MAX) {
+        errno = EOVERFLOW;
+        if (failed_op)
+            *failed_op = "size";
+        return 0;
+    }
+    return 1;
+}
+
+int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h,
+                    const char **failed_op)
+{
+    if (!png_size_ok(w, h, failed_op))
+        return -1;
+    return write_png(path, rgb, NULL, NULL, w, h, failed_op);
+}
+
+int image_write_png_alpha(const char *path, const uint8_t *rgb, const uint8_t *alpha, uint32_t w,
+                          uint32_t h, const char **failed_op)
+{
+    if (!png_size_ok(w, h, failed_op))
+        return -1;
+    uint8_t *row = malloc(4 * (size_t)w);
+    if (!row) {
+        errno = ENOMEM;
+        if (failed_op)
+            *failed_op = "png";
+        return -1;
+    }
+    int r = write_png(path, rgb, alpha, row, w, h, failed_op);
+    int e = errno;
+    free(row);
+    errno = e;
+    return r;
 }
 
 /* PFM with `ch` channels (1: "Pf", 3: "PF"), bottom row first. */

@@ -20,6 +20,11 @@ uint8_t image_srgb8(float linear);
 int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h,
                     const char **failed_op);
 
+/* The same as an 8-bit RGBA PNG: alpha is w*h bytes (straight, not
+ * premultiplied), rows top to bottom. */
+int image_write_png_alpha(const char *path, const uint8_t *rgb, const uint8_t *alpha, uint32_t w,
+                          uint32_t h, const char **failed_op);
+
 /* Writes a grayscale PFM ("Pf", scale -1.0: little-endian float32), rows
  * stored bottom to top as the format defines; `values` is w*h floats, rows
  * top to bottom (+inf allowed). Same return convention. */

@@ -1,0 +1,41 @@
+/* aa: adaptive antialiasing (RENDER.md, "Antialiasing"). Every pixel gets
+ * its centre ray first; a pixel whose centre ray differs from one of its
+ * four neighbours' (hit or miss, surface, depth by more than
+ * AA_DEPTH_REL of the nearer t, normal by more than AA_NORMAL_COS) is then
+ * traced again with N x N stratified samples: the centres of the N x N
+ * sub-squares of the pixel. The decision reads only centre rays, so the
+ * image is the same whatever the thread count. */
+#ifndef AA_H
+#define AA_H
+
+#include <stdint.h>
+
+#define AA_MAX 16
+#define AA_DEPTH_REL 0.01f   /* |t - t'| > 1 % of min(t, t') */
+#define AA_NORMAL_COS 0.866f /* normals more than 30 degrees apart */
+
+/* What the edge test keeps of a pixel's centre ray. */
+typedef struct aa_probe {
+    float t;
+    float t_lo;       /* the beam's start for the centre ray's sub-block (rounded down) */
+    float n[3];
+    uint16_t surface;
+    uint8_t hit;
+} aa_probe;
+
+/* 1 when the centre rays a and b differ by the rule above. */
+int aa_differs(const aa_probe *a, const aa_probe *b);
+
+/* 1 when pixel (i, j) of the w x h probes (rows top to bottom) needs its
+ * samples: it differs from a 4-neighbour inside the image. */
+int aa_needs(const aa_probe *probes, uint32_t w, uint32_t h, uint32_t i, uint32_t j);
+
+/* Offset of sample k (k < n * n) inside the pixel, in pixel units, each in
+ * (0, 1): the centre of sub-square (k % n, k / n). */
+static inline void aa_sample_offset(unsigned n, unsigned k, double *fx, double *fy)
+{
+    *fx = ((double)(k % n) + 0.5) / (double)n;
+    *fy = ((double)(k / n) + 0.5) / (double)n;
+}
+
+#endif

@@ -1,0 +1,75 @@
+/* ao: cosine-weighted hemisphere rays, deterministic per pixel. */
+#include "render/ao.h"
+
+#include <math.h>
+
+#include "render/shadow.h"
+
+uint32_t ao_seed(uint32_t i, uint32_t j)
+{
+    uint64_t x = ((uint64_t)j << 32 | i) + UINT64_C(0x9e3779b97f4a7c15);
+    x = (x ^ (x >> 30)) * UINT64_C(0xbf58476d1ce4e5b9);
+    x = (x ^ (x >> 27)) * UINT64_C(0x94d049bb133111eb);
+    return (uint32_t)((x ^ (x >> 31)) >> 32);
+}
+
+void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3])
+{
+    double nn[3] = {n[0], n[1], n[2]};
+    const double len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    for (int a = 0; a < 3; a++)
+        nn[a] /= len;
+    /* an orthonormal basis t, b, nn (Duff et al. 2017, branchless) */
+    const double sg = nn[2] >= 0.0 ? 1.0 : -1.0;
+    const double ka = -1.0 / (sg + nn[2]), kb = nn[0] * nn[1] * ka;
+    const double t[3] = {1.0 + sg * nn[0] * nn[0] * ka, sg * kb, -sg * nn[0]};
+    const double b[3] = {kb, sg + nn[1] * nn[1] * ka, -nn[1]};
+    const double u = ((double)k + 0.5) / (double)m;
+    double turns = (double)k * 0.61803398874989484820 + (double)seed * 0x1p-32;
+    turns -= floor(turns);
+    const double phi = 2.0 * M_PI * turns;
+    const double r = sqrt(u), c = sqrt(1.0 - u);
+    const double x = r * cos(phi), y = r * sin(phi);
+    for (int a = 0; a < 3; a++)
+        d[a] = x * t[a] + y * b[a] + c * nn[a];
+}
+
+float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
+                uint32_t seed, uint64_t *steps)
+{
+    const double dist = AO_DISTANCE * tree->edge;
+    if (!traverse)
+        traverse = trace_impls[0].traverse;
+    /* the rays share their start: its grid position once, and the deepest
+       occupied cell around it, where every ray's descent would arrive */
+    trace_eye e;
+    if (!trace_eye_init(tree, o, &e))
+        return 1.0f; /* as trace_setup: no ray, nothing in the way */
+    trace_anchor an;
+    an.depth = 0;
+    if (e.inside[0] && e.inside[1] && e.inside[2]) {
+        const double margin = 0x1p-10 + 0x1p-36 * e.n;
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = e.o[a] - margin;
+            hi[a] = e.o[a] + margin;
+        }
+        trace_anchor_find(tree, lo, hi, &an);
+    }
+    unsigned open = 0;
+    for (unsigned k = k0; k < k0 + count; k++) {
+        double d[3];
+        ao_direction(n, k, m, seed, d);
+        trace_ray r;
+        if (!trace_setup_eye(&e, d, &r) || !trace_clip(&r, 0.0, dist)) {
+            open++;
+            continue;
+        }
+        trace_hit h;
+        traverse(tree, opts, &r, &an, &h);
+        *steps += h.steps;
+        open += !h.hit;
+    }
+    return (float)open / (float)count;
+}

@@ -1,0 +1,38 @@
+/* ao: ambient occlusion. From the start point of render/shadow.h, rays over
+ * the hemisphere of the viewer-facing normal, cosine-weighted, each up to
+ * AO_DISTANCE (a fraction of the cube's edge); the ambient term is scaled
+ * by the fraction that meet nothing (RENDER.md, "Ambient occlusion").
+ *
+ * Directions: ray k of M is u_k = (k + 1/2) / M (stratified in cos^2 of the
+ * angle to the normal: cosine weighting), azimuth 2 pi frac(k phi + s) with
+ * phi the golden ratio's fraction and s a hash of the pixel: a fixed
+ * pattern a pixel, rotated from pixel to pixel, the same whatever thread
+ * traces it. cos = sqrt(1 - u_k) >= sqrt(1 / (2M)) > 0: every ray leaves
+ * the surface's side, so a plane alone occludes none (factor 1 exactly). */
+#ifndef AO_H
+#define AO_H
+
+#include <stdint.h>
+
+#include "format/oct.h"
+#include "render/trace.h"
+#include "render/trace_impl.h"
+
+#define AO_DISTANCE 0.125 /* ray length, in cube edges */
+#define AO_MAX_RAYS 4096  /* --ao 0..AO_MAX_RAYS */
+
+/* The per-pixel rotation seed of pixel (i, j) (a 32-bit hash). */
+uint32_t ao_seed(uint32_t i, uint32_t j);
+
+/* Direction of ray k of M (k < M) over the hemisphere of unit n, rotated by
+ * `seed`, in d[3] (unit). */
+void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3]);
+
+/* The unoccluded fraction of rays k0 .. k0 + count - 1 of M from the world
+ * point o (shadow_origin's) over unit n: (rays meeting nothing) / count,
+ * count >= 1. Adds the rays' DDA steps to *steps. */
+float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
+                uint32_t seed, uint64_t *steps);
+
+#endif

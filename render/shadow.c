@@ -1,0 +1,62 @@
+/* shadow: start point and any-hit cast of secondary rays. */
+#include "render/shadow.h"
+
+#include <math.h>
+
+#include "format/oct_normal.h"
+
+double shadow_offset(const float n[3])
+{
+    return (double)fabsf(n[0]) + (double)fabsf(n[1]) + (double)fabsf(n[2]) + 0.25;
+}
+
+/* 1 when the voxel holding grid point g is known occupied. */
+static int voxel_occupied(const oct_tree *tree, const double g[3])
+{
+    const double m = 0x1p-10;
+    const double lo[3] = {g[0] - m, g[1] - m, g[2] - m}, hi[3] = {g[0] + m, g[1] + m, g[2] + m};
+    trace_anchor an;
+    trace_anchor_find(tree, lo, hi, &an);
+    if (an.depth + 1 != tree->levels)
+        return 0; /* an empty cell above the voxels, outside the cube, or a box on a face */
+    const unsigned c = ((uint32_t)lo[0] & 1u) | ((uint32_t)lo[1] & 1u) << 1 |
+                       ((uint32_t)lo[2] & 1u) << 2;
+    return (int)(an.node[an.depth].mask >> c & 1u);
+}
+
+int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])
+{
+    const uint32_t rec = tree->voxels[hit->voxel];
+    float ns[3]; /* the stored normal: the plane's, n or -n */
+    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, ns);
+    const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
+    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
+    double g[3];
+    for (unsigned k = 0; k < SHADOW_TRIES; k++) {
+        const double h = shadow_offset(n) + (double)k;
+        for (int a = 0; a < 3; a++)
+            g[a] = (double)hit->xyz[a] + 0.5 + off * (double)ns[a] + h * (double)n[a];
+        if (!voxel_occupied(tree, g)) {
+            for (int a = 0; a < 3; a++)
+                o[a] = tree->origin[a] + g[a] * vox;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                   const double o[3], const double d[3], double t_max, uint64_t *steps)
+{
+    trace_ray r;
+    if (!trace_setup(tree, o, d, &r))
+        return 0; /* the ray misses the cube */
+    if (t_max < INFINITY && !trace_clip(&r, 0.0, t_max))
+        return 0;
+    trace_hit h;
+    if (!traverse)
+        traverse = trace_impls[0].traverse;
+    traverse(tree, opts, &r, NULL, &h);
+    *steps += h.steps;
+    return h.hit;
+}

@@ -1,0 +1,54 @@
+/* shadow: secondary rays from a hit (shadow rays, ambient occlusion rays)
+ * through the same octree and the same traversal as the primary rays. They
+ * only ask "is anything in the way": the traversal stops at the first
+ * occupied voxel it meets (with --refine, the first whose planes the ray
+ * crosses), which is what the primary traversal does too, so no third
+ * traversal is needed.
+ *
+ * Start point (RENDER.md, "Shadows"): from the hit voxel's stored plane
+ * n . (p - centre) = offset (the plane --refine uses), the point of that
+ * plane nearest the voxel's centre moved SHADOW_OFFSET(n) voxel edges along
+ * the viewer-facing normal, where
+ *     SHADOW_OFFSET(n) = |n|_1 + 0.25   (1.25 .. 1.99 voxels).
+ * For a plane with unit normal n, a voxel meets it only when its centre is
+ * within |n|_1 / 2 of it, so every point of every voxel of the plane is
+ * within |n|_1; the start point is |n|_1 + 0.25 away on the facing side
+ * (the 0.25 covers the stored normal's and offset's rounding), and a ray
+ * leaving it with d . n > 0 only gets farther: a surface never shadows
+ * itself (no acne). A point whose light lies behind its facing normal gets
+ * no light at all (no shadow ray), so a wall can only be lit from the side
+ * it is seen from: light cannot leak through it, however thin. What the
+ * offset skips is an occluder nearer than SHADOW_OFFSET along the normal
+ * (under 2 voxels); a shadow's outline moves by up to SHADOW_OFFSET times
+ * the sine of the light's angle to the normal. A start point inside an
+ * occupied voxel is moved on (shadow_origin). */
+#ifndef SHADOW_H
+#define SHADOW_H
+
+#include <stdint.h>
+
+#include "format/oct.h"
+#include "render/trace.h"
+#include "render/trace_impl.h"
+
+/* The offset rule above, in voxel edges, for a unit normal n. */
+double shadow_offset(const float n[3]);
+
+#define SHADOW_TRIES 3
+
+/* World position of the start point of secondary rays from the hit voxel
+ * `hit` (hit->hit set) with viewer-facing unit normal n, in o; returns 1.
+ * Where that point falls in an occupied voxel (at a crease, or where
+ * surfaces crowd: the voxel's normal does not point to open space), it
+ * moves one voxel further along n, up to SHADOW_TRIES - 1 times; returns 0
+ * when it is still inside one (the caller then treats the point as lit and
+ * open: a start inside the surface would shadow it by itself). */
+int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3]);
+
+/* 1 when the ray o + t d (d unit), 0 <= t <= t_max (+inf allowed), meets an
+ * occupied voxel (by opts' rule), traced by `traverse` (NULL: the build's
+ * preferred implementation); 0 otherwise. Adds its DDA steps to *steps. */
+int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                   const double o[3], const double d[3], double t_max, uint64_t *steps);
+
+#endif

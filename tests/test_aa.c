@@ -1,0 +1,260 @@
+/* Tests for render/aa and the frame's antialiasing pass: coverage (alpha)
+ * of a sphere's silhouette against the exact area of the disc over each
+ * pixel square (numeric integration); the edge test's rule; colour
+ * averaged in linear light; depth kept from the centre ray; the image the
+ * same whatever the thread count and traversal implementation. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench/tree_util.h"
+#include "common/view/image.h"
+#include "render/aa.h"
+#include "render/frame.h"
+#include "tests/voxel_shapes.h"
+
+#define W 80
+#define H 72
+
+typedef struct scene {
+    oct_tree *tree;
+    camera cam;
+    double rho; /* the silhouette's radius in (u, v) units */
+} scene;
+
+/* A sphere of radius r voxels at the centre of a 2^levels cube, seen along
+ * -z from distance dist voxels. */
+static scene sphere_scene(unsigned levels, double r, double dist, double fov)
+{
+    scene s;
+    const double n = (double)(1u << levels), c = 0.5 * n;
+    shape sh = shape_sphere(c, c, c, r);
+    s.tree = shapes_build(levels, n, &sh, 1, 1);
+    assert_non_null(s.tree);
+    const double eye[3] = {c, c, c + dist}, target[3] = {c, c, c}, up[3] = {0, 1, 0};
+    assert_int_equal(camera_init(&s.cam, eye, target, up, fov, W, H), CAMERA_OK);
+    s.rho = r / sqrt(dist * dist - r * r);
+    return s;
+}
+
+/* Exact area fraction of the disc u^2 + v^2 < rho^2 over pixel (i, j), by
+ * 128 x 128 midpoint samples. */
+static double disc_cover(const camera *cam, double rho, uint32_t i, uint32_t j)
+{
+    const int k = 128;
+    unsigned in = 0;
+    for (int b = 0; b < k; b++)
+        for (int a = 0; a < k; a++) {
+            const double x = i + (a + 0.5) / k, y = j + (b + 0.5) / k;
+            const double u = (2.0 * x / cam->width - 1.0) * cam->h * cam->width / cam->height;
+            const double v = (1.0 - 2.0 * y / cam->height) * cam->h;
+            in += u * u + v * v < rho * rho;
+        }
+    return (double)in / (k * k);
+}
+
+static void render(const scene *s, unsigned aa, int refine, trace_traverse_fn fn,
+                   unsigned threads, uint8_t *rgb, uint8_t *alpha, float *depth, frame_stats *st)
+{
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = s->tree;
+    job.cam = &s->cam;
+    job.opts.split = s->tree->levels;
+    job.opts.refine = refine;
+    job.shade.ambient = 0.2f;
+    shade_default_light(&s->cam, job.shade.light);
+    job.rgb = rgb;
+    job.alpha = alpha;
+    job.depth = depth;
+    job.threads = threads;
+    job.beam_size = FRAME_BEAM_DEFAULT;
+    job.traverse = fn;
+    job.aa = aa;
+    assert_int_equal(frame_render(&job, st), 0);
+}
+
+static void test_coverage_matches_disc(void **state)
+{
+    (void)state;
+    scene s = sphere_scene(9, 200.0, 700.0, 100.0);
+    uint8_t *rgb = malloc(W * H * 3), *alpha = malloc(W * H);
+    assert_non_null(rgb);
+    assert_non_null(alpha);
+    for (int refine = 0; refine <= 1; refine++) {
+        frame_stats st;
+        render(&s, 4, refine, NULL, 2, rgb, alpha, NULL, &st);
+        double sum_edge = 0.0, sum_all = 0.0;
+        unsigned edge = 0;
+        for (uint32_t j = 0; j < H; j++)
+            for (uint32_t i = 0; i < W; i++) {
+                const double exact = disc_cover(&s.cam, s.rho, i, j);
+                const double err = fabs(alpha[j * W + i] / 255.0 - exact);
+                sum_all += err;
+                if (exact > 0.0 && exact < 1.0) {
+                    sum_edge += err;
+                    edge++;
+                }
+            }
+        print_message("refine %d: %u silhouette pixels, mean |alpha - exact| %.4f there, "
+                      "%.5f over the image, %.1f%% edge pixels, %.1f%% supersampled\n",
+                      refine, edge, sum_edge / edge, sum_all / (W * H),
+                      100.0 * (double)st.aa_pixels / (W * H), 100.0 * (double)st.aa_full / (W * H));
+        assert_true(edge > 60);
+        assert_true(sum_edge / edge <= 0.08);
+        assert_true(sum_all / (W * H) <= 0.002);
+    }
+    free(rgb);
+    free(alpha);
+    tree_util_free(s.tree);
+}
+
+/* Same image whatever the thread count, the implementation and the beam;
+ * depth is the centre ray's (the image with --aa 1); only pixels next to
+ * an edge are supersampled, and every one of them is. */
+static void test_deterministic_and_centre_depth(void **state)
+{
+    (void)state;
+    scene s = sphere_scene(7, 40.0, 160.0, 40.0);
+    const size_t np = W * H;
+    uint8_t *rgb = malloc(np * 3), *ref = malloc(np * 3), *alpha = malloc(np),
+            *aref = malloc(np), *plain = malloc(np * 3);
+    float *depth = malloc(np * sizeof *depth), *dref = malloc(np * sizeof *dref);
+    assert_true(rgb && ref && alpha && aref && plain && depth && dref);
+    frame_stats st, st1;
+    render(&s, 1, 0, NULL, 1, plain, NULL, dref, &st1);
+    render(&s, 3, 0, NULL, 1, ref, aref, depth, &st);
+    assert_memory_equal(depth, dref, np * sizeof *depth);
+    assert_true(st.aa_pixels > 0 && st.aa_pixels < np / 4);
+    /* 3 x 3: the four corners of each edge pixel, the five others where
+       those disagree */
+    assert_true(st.rays == np + 4 * st.aa_pixels + 5 * st.aa_full);
+    assert_true(st.aa_full > 0 && st.aa_full < st.aa_pixels);
+    for (unsigned impl = 0; impl < trace_impl_count; impl++)
+        for (unsigned th = 1; th <= 5; th += 2) {
+            render(&s, 3, 0, trace_impls[impl].traverse, th, rgb, alpha, depth, &st1);
+            assert_memory_equal(rgb, ref, np * 3);
+            assert_memory_equal(alpha, aref, np);
+            assert_memory_equal(depth, dref, np * sizeof *depth);
+            assert_true(st1.aa_pixels == st.aa_pixels && st1.aa_full == st.aa_full);
+        }
+    /* a pixel that is not supersampled keeps its one ray's colour; one
+       whose alpha is partial was supersampled */
+    unsigned partial = 0;
+    for (size_t k = 0; k < np; k++)
+        if (aref[k] != 0 && aref[k] != 255)
+            partial++;
+    assert_true(partial > 20 && partial <= st.aa_full);
+    free(rgb);
+    free(ref);
+    free(alpha);
+    free(aref);
+    free(plain);
+    free(depth);
+    free(dref);
+    tree_util_free(s.tree);
+}
+
+/* The edge rule, one criterion at a time. */
+static void test_edge_rule(void **state)
+{
+    (void)state;
+    aa_probe a = {100.0f, INFINITY, {0, 0, 1}, 0, 1}, b = a;
+    assert_false(aa_differs(&a, &b));
+    b.hit = 0;
+    assert_true(aa_differs(&a, &b));
+    b = a;
+    b.surface = 1;
+    assert_true(aa_differs(&a, &b));
+    b = a;
+    b.t = 100.0f * (1.0f + 0.9f * AA_DEPTH_REL);
+    assert_false(aa_differs(&a, &b));
+    b.t = 100.0f * (1.0f + 1.1f * AA_DEPTH_REL);
+    assert_true(aa_differs(&a, &b));
+    b = a;
+    b.n[0] = 0.6f; /* 37 degrees */
+    b.n[2] = 0.8f;
+    assert_true(aa_differs(&a, &b));
+    b.n[0] = 0.3f; /* 17 degrees */
+    b.n[2] = 0.954f;
+    assert_false(aa_differs(&a, &b));
+    aa_probe m1 = a, m2 = a; /* two misses never differ */
+    m1.hit = m2.hit = 0;
+    m1.t = 1.0f;
+    assert_false(aa_differs(&m1, &m2));
+}
+
+/* Colour is averaged in linear light: half the samples on white, half on
+ * black gives sRGB of 0.5, not 128. */
+static void test_linear_average(void **state)
+{
+    (void)state;
+    /* a plane z = 10.5 over the right half of a 2^5 cube, seen from above:
+       pixels whose two sample columns straddle its edge x = 16 are half
+       covered */
+    shape sh = shape_plane(0, 0, 1, 10.5);
+    sh.lo[0] = 16;
+    oct_tree *t = shapes_build(5, 32.0, &sh, 1, 1);
+    assert_non_null(t);
+    scene s;
+    s.tree = t;
+    /* the edge 0.185 voxel (half a pixel) right of the image's
+       middle: between the sample columns of column 40 */
+    const double eye[3] = {15.815, 16, 100}, target[3] = {15.815, 16, 0}, up[3] = {0, 1, 0};
+    assert_int_equal(camera_init(&s.cam, eye, target, up, 17.0, W, H), CAMERA_OK);
+    uint8_t *rgb = malloc(W * H * 3);
+    assert_non_null(rgb);
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = t;
+    job.cam = &s.cam;
+    job.opts.split = 5;
+    job.shade.ambient = 1.0f; /* the palette colour, white */
+    shade_default_light(&s.cam, job.shade.light);
+    job.rgb = rgb;
+    job.threads = 1;
+    job.beam_size = FRAME_BEAM_DEFAULT;
+    job.aa = 2;
+    frame_stats st;
+    assert_int_equal(frame_render(&job, &st), 0);
+    uint8_t *cov = malloc(W * H), *rgba = malloc(W * H * 3);
+    assert_non_null(cov);
+    assert_non_null(rgba);
+    job.alpha = cov; /* the same samples, their coverage */
+    job.rgb = rgba;
+    assert_int_equal(frame_render(&job, &st), 0);
+    unsigned halves = 0;
+    for (size_t k = 0; k < (size_t)W * H; k++) {
+        const unsigned hits = (cov[k] * 4u + 127u) / 255u;
+        assert_int_equal(cov[k], (hits * 255u + 2u) / 4u);
+        /* white samples (ambient 1) over black: sRGB of the linear mean */
+        assert_int_equal(rgb[3 * k], image_srgb8((float)hits / 4.0f));
+        if (hits == 2)
+            halves++;
+        if (hits) /* straight alpha: the covered part's colour */
+            assert_int_equal(rgba[3 * k], 255);
+    }
+    assert_true(halves >= H / 2);
+    assert_true(image_srgb8(0.5f) > 180); /* 188: not the 128 of averaging codes */
+    free(cov);
+    free(rgba);
+    free(rgb);
+    tree_util_free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_coverage_matches_disc),
+        cmocka_unit_test(test_deterministic_and_centre_depth),
+        cmocka_unit_test(test_edge_rule),
+        cmocka_unit_test(test_linear_average),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

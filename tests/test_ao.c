@@ -1,0 +1,175 @@
+/* Tests for render/ao: directions on the normal's side, unit, the same for
+ * the same pixel; a plane alone is open (factor 1, exactly); the inside of
+ * a concave corner is darker than its open floor; the frame's AO image is
+ * the same on every traversal implementation and thread count. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench/tree_util.h"
+#include "format/oct_normal.h"
+#include "render/ao.h"
+#include "render/frame.h"
+#include "render/shadow.h"
+#include "tests/voxel_shapes.h"
+
+#define LEVELS 6
+#define NV 64.0
+
+static void test_directions(void **state)
+{
+    (void)state;
+    static const float ns[][3] = {{0, 0, 1}, {0, 0, -1}, {0.6f, 0.0f, 0.8f}, {-0.48f, 0.6f, -0.64f}};
+    for (size_t k = 0; k < sizeof ns / sizeof ns[0]; k++)
+        for (unsigned m = 1; m <= 64; m *= 4)
+            for (unsigned r = 0; r < m; r++) {
+                double d[3], e[3];
+                ao_direction(ns[k], r, m, ao_seed(3, 7), d);
+                ao_direction(ns[k], r, m, ao_seed(3, 7), e);
+                assert_memory_equal(d, e, sizeof d);
+                const double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                assert_true(fabs(len - 1.0) < 1e-12);
+                const double c = d[0] * ns[k][0] + d[1] * ns[k][1] + d[2] * ns[k][2];
+                assert_true(c >= sqrt(0.5 / m) - 1e-6); /* cos of the last stratum */
+            }
+    assert_true(ao_seed(3, 7) != ao_seed(7, 3));
+    assert_true(ao_seed(0, 0) != ao_seed(1, 0));
+}
+
+/* The AO factor of the surface point under (x, y), looked at from above;
+ * -1 when there is none. */
+static float factor_at(const oct_tree *t, const trace_opts *o, trace_traverse_fn fn, double x,
+                       double y, unsigned rays)
+{
+    const double eye[3] = {x, y, NV - 0.5}, down[3] = {0, 0, -1};
+    trace_hit h;
+    if (!trace_ray_cast(t, o, eye, down, &h))
+        return -1.0f;
+    float n[3];
+    oct_normal_decode(t->voxels[h.voxel] & OCT_VOXEL_NORMAL_MASK, n);
+    if (n[2] < 0.0f)
+        for (int a = 0; a < 3; a++)
+            n[a] = -n[a];
+    double org[3];
+    assert_true(shadow_origin(t, &h, n, org));
+    uint64_t steps = 0;
+    return ao_factor(t, o, fn, org, n, 0, rays, rays, ao_seed((uint32_t)x, (uint32_t)y), &steps);
+}
+
+static void test_plane_alone_is_open(void **state)
+{
+    (void)state;
+    static const double normals[][3] = {{0, 0, 1}, {0.3, -0.2, 1}, {0.7, 0.6, 1}};
+    for (size_t p = 0; p < sizeof normals / sizeof normals[0]; p++) {
+        shape s = shape_plane(normals[p][0], normals[p][1], normals[p][2], 0.0);
+        s.d = s.n[0] * 32 + s.n[1] * 32 + s.n[2] * 20;
+        oct_tree *t = shapes_build(LEVELS, NV, &s, 1, 1);
+        assert_non_null(t);
+        for (unsigned impl = 0; impl < trace_impl_count; impl++)
+            for (int refine = 0; refine <= 1; refine++) {
+                trace_opts o = {LEVELS, refine};
+                unsigned tested = 0;
+                for (double y = 4.3; y < 60; y += 5.1)
+                    for (double x = 4.7; x < 60; x += 5.3) {
+                        float f = factor_at(t, &o, trace_impls[impl].traverse, x, y, 64);
+                        if (f < 0.0f)
+                            continue; /* the plane leaves the cube there */
+                        assert_true(f == 1.0f);
+                        tested++;
+                    }
+                assert_true(tested > 40);
+            }
+        tree_util_free(t);
+    }
+}
+
+static void test_concave_corner_is_darker(void **state)
+{
+    (void)state;
+    shape sh[2] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5)};
+    sh[0].lo[0] = 20; /* floor from the wall on */
+    sh[1].lo[2] = 20; /* wall from the floor up */
+    oct_tree *t = shapes_build(LEVELS, NV, sh, 2, 1);
+    assert_non_null(t);
+    for (unsigned impl = 0; impl < trace_impl_count; impl++)
+        for (int refine = 0; refine <= 1; refine++) {
+            trace_opts o = {LEVELS, refine};
+            trace_traverse_fn fn = trace_impls[impl].traverse;
+            /* AO_DISTANCE is 8 voxels here: open beyond it, dark near the wall */
+            const float open = factor_at(t, &o, fn, 40.5, 30.5, 256);
+            const float mid = factor_at(t, &o, fn, 25.5, 30.5, 256);
+            const float corner = factor_at(t, &o, fn, 22.5, 30.5, 256);
+            assert_true(open == 1.0f);
+            assert_true(mid < open);
+            assert_true(corner < mid);
+            assert_true(corner < 0.85f);
+        }
+    tree_util_free(t);
+}
+
+static void render_ao(const oct_tree *t, const camera *cam, trace_traverse_fn fn,
+                      unsigned threads, unsigned aa, uint8_t *rgb)
+{
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = t;
+    job.cam = cam;
+    job.opts.split = LEVELS;
+    job.shade.ambient = 0.3f;
+    job.shade.ao_rays = 16;
+    job.shade.shadows = 1;
+    shade_default_light(cam, job.shade.light);
+    job.rgb = rgb;
+    job.threads = threads;
+    job.beam_size = FRAME_BEAM_DEFAULT;
+    job.traverse = fn;
+    job.aa = aa;
+    frame_stats st;
+    assert_int_equal(frame_render(&job, &st), 0);
+    assert_true(st.ao_rays >= 16 * st.hits);
+}
+
+static void test_frame_ao_deterministic(void **state)
+{
+    (void)state;
+    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
+                   shape_sphere(40, 40, 30, 8)};
+    sh[0].lo[0] = 20;
+    sh[1].lo[2] = 20;
+    oct_tree *t = shapes_build(LEVELS, NV, sh, 3, 1);
+    assert_non_null(t);
+    const double eye[3] = {150, 110, 120}, target[3] = {32, 32, 24}, up[3] = {0, 0, 1};
+    camera cam;
+    assert_int_equal(camera_init(&cam, eye, target, up, 30, 96, 80), CAMERA_OK);
+    uint8_t *ref = malloc(96 * 80 * 3), *rgb = malloc(96 * 80 * 3);
+    assert_non_null(ref);
+    assert_non_null(rgb);
+    for (unsigned aa = 1; aa <= 3; aa += 2) {
+        render_ao(t, &cam, NULL, 1, aa, ref);
+        for (unsigned impl = 0; impl < trace_impl_count; impl++)
+            for (unsigned th = 1; th <= 4; th += 3) {
+                render_ao(t, &cam, trace_impls[impl].traverse, th, aa, rgb);
+                assert_memory_equal(rgb, ref, 96 * 80 * 3);
+            }
+    }
+    free(ref);
+    free(rgb);
+    tree_util_free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_directions),
+        cmocka_unit_test(test_plane_alone_is_open),
+        cmocka_unit_test(test_concave_corner_is_darker),
+        cmocka_unit_test(test_frame_ao_deterministic),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
