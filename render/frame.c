@@ -16,6 +16,8 @@ typedef struct frame_shared {
     const frame_job *job;
     uint32_t tiles_x, tiles_y;
     atomic_uint_fast64_t next, done, hits, steps;
+    exact_worker *exact; /* one per thread with --exact, else NULL */
+    atomic_uint next_exact;
 } frame_shared;
 
 /* image_srgb8 without pow: the code value is the number of thresholds at or
@@ -202,12 +204,18 @@ static void work(frame_shared *sh, int caller)
 {
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
     uint64_t hits = 0, steps = 0;
+    frame_job own; /* with --exact: the job with this thread's exact worker */
+    const frame_job *job = sh->job;
+    if (sh->exact) {
+        own = *job;
+        own.opts.exact = &sh->exact[atomic_fetch_add(&sh->next_exact, 1)];
+        job = &own;
+    }
     for (;;) {
         uint64_t t = atomic_fetch_add(&sh->next, 1);
         if (t >= total)
             break;
-        render_tile(sh->job, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x), &hits,
-                    &steps);
+        render_tile(job, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x), &hits, &steps);
         uint64_t d = atomic_fetch_add(&sh->done, 1) + 1;
         if (caller && sh->job->progress)
             sh->job->progress(sh->job->progress_ctx, d, total);
@@ -233,7 +241,22 @@ int frame_render(const frame_job *job, frame_stats *stats)
     atomic_init(&sh.done, 0);
     atomic_init(&sh.hits, 0);
     atomic_init(&sh.steps, 0);
+    atomic_init(&sh.next_exact, 0);
     unsigned extra = job->threads > 1 ? job->threads - 1 : 0;
+    sh.exact = NULL;
+    if (job->exact) {
+        sh.exact = calloc(extra + 1, sizeof *sh.exact);
+        unsigned k = 0;
+        while (sh.exact && k <= extra && exact_worker_init(&sh.exact[k], job->exact) == 0)
+            k++;
+        if (!sh.exact || k <= extra) {
+            for (unsigned i = 0; sh.exact && i < k; i++)
+                exact_worker_free(&sh.exact[i]);
+            free(sh.exact);
+            stats->rays = stats->hits = stats->steps = 0;
+            return ENOMEM;
+        }
+    }
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;
     int rc = 0;
     unsigned started = 0;
@@ -248,6 +271,9 @@ int frame_render(const frame_job *job, frame_stats *stats)
     for (unsigned k = 0; k < started; k++)
         pthread_join(tid[k], NULL);
     free(tid);
+    for (unsigned k = 0; sh.exact && k <= extra; k++)
+        exact_worker_free(&sh.exact[k]);
+    free(sh.exact);
     stats->rays = (uint64_t)job->cam->width * job->cam->height;
     stats->hits = atomic_load(&sh.hits);
     stats->steps = atomic_load(&sh.steps);

@@ -35,16 +35,23 @@ void shade_hit(const oct_tree *tree, const shade_params *p, const trace_hit *hit
         }
         return;
     }
-    uint32_t rec = tree->voxels[hit->voxel];
-    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
-    double facing = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
-    if (facing > 0.0) /* two-sided: face the viewer */
+    unsigned s;
+    if (hit->exact) { /* the gradient, already facing the viewer; the root's surface */
         for (int a = 0; a < 3; a++)
-            n[a] = -n[a];
+            n[a] = (float)hit->normal[a];
+        s = hit->surface;
+    } else {
+        uint32_t rec = tree->voxels[hit->voxel];
+        oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
+        double facing = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+        if (facing > 0.0) /* two-sided: face the viewer */
+            for (int a = 0; a < 3; a++)
+                n[a] = -n[a];
+        s = tree->surfaces ? tree->surfaces[hit->voxel] : 0;
+    }
     double lam = n[0] * p->light[0] + n[1] * p->light[1] + n[2] * p->light[2];
     if (lam < 0.0)
         lam = 0.0;
-    unsigned s = tree->surfaces ? tree->surfaces[hit->voxel] : 0;
     if (s >= tree->surface_count)
         s = 0;
     const float *col = tree->palette + 3 * s;

@@ -466,7 +466,7 @@ static void check_exact(const oct_tree *t, const uint32_t (*vox)[3], size_t n, c
     st->rays++;
     st->hits += want >= 0;
     for (unsigned k = k_lo; k <= k_hi; k++) {
-        trace_opts opts = {k, 0};
+        trace_opts opts = {k, 0, NULL};
         trace_hit h;
         trace_cast_all(t, &opts, eye, dir, &h);
         st->traces++;
@@ -680,7 +680,7 @@ static void test_general_rays_tolerance(void **state)
             const int aimed = ri % 3 == 0 && ri % 7 != 0;
             const unsigned k0 = levels > 8 ? levels - 9 : 0, kstep = levels > 8 ? 3 : 1;
             for (unsigned k = k0; k <= levels; k += kstep) {
-                trace_opts opts = {k, 0};
+                trace_opts opts = {k, 0, NULL};
                 trace_hit h;
                 trace_cast_all(t, &opts, eye, dir, &h);
                 st.traces++;
@@ -822,7 +822,7 @@ static void shoot_at_shell(const oct_tree *t, const uint32_t (*v)[3], size_t n, 
             back[a] = -dir[a];
         }
         for (unsigned k = 0; k <= t->levels; k++) {
-            trace_opts o = {k, 0};
+            trace_opts o = {k, 0, NULL};
             trace_hit hin, hout;
             trace_cast_all(t, &o, eye, dir, &hin);
             trace_cast_all(t, &o, far, back, &hout);
@@ -901,7 +901,7 @@ static void test_step_bound(void **state)
         assert_non_null(t);
         /* d = (1, 1 - e, 1 - 2e): crosses each axis' planes at distinct times */
         const double eye[3] = {0, 0, 0}, dir[3] = {1, 1 - 0x1p-30, 1 - 0x1p-29};
-        trace_opts o = {0, 0};
+        trace_opts o = {0, 0, NULL};
         trace_hit h;
         assert_int_equal(trace_cast_all(t, &o, eye, dir, &h), 1);
         assert_true(h.steps <= trace_max_steps(levels));
