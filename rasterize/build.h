@@ -22,6 +22,7 @@ typedef struct build_params {
      * may be NULL. */
     void (*progress)(void *ctx, double fraction);
     void *progress_ctx;
+    int shell_only;      /* --shell-only: voxels without records (no normals, no Newton steps) */
 } build_params;
 
 /* What the build did, for the summary and the benchmark. */

@@ -161,6 +161,10 @@ static inline const double *centre_fg(worker *wk, unsigned s, const double centr
  * its Newton iteration and forgets the centre values (wk->cf). */
 unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw);
 
+/* --shell-only: the voxel's surface without a record (no normal, no Newton
+ * steps); forgets the centre values as voxel_surface does. */
+unsigned shell_surface(worker *wk, unsigned idx, const double centre[3]);
+
 /* Appends the voxel's record (lists at index levels + 1). 0 when memory
  * runs out (then wk->failed is set). */
 int emit_voxel(worker *wk, const interval box[3], const double centre[3]);

@@ -15,6 +15,7 @@
 #include "common/test_hooks.h"
 #include "common/version.h"
 #include "common/expr/scene.h"
+#include "common/expr/tape_io.h"
 #include "format/oct.h"
 #include "rasterize/build.h"
 
@@ -22,11 +23,12 @@
 
 static const char usage_text[] =
     "usage: rasterize SCENE -o OUT.oct [--levels N] [--method interval|lipschitz]\n"
-    "                 [--threads N] [-q]\n";
+    "                 [--threads N] [--shell-only] [-q]\n";
 
 static const char help_text[] =
     "Subdivide space once around the implicit surfaces of SCENE and write the\n"
-    "voxels they pass through (normal, plane offset, surface) as a sparse octree.\n"
+    "voxels they pass through (normal, plane offset, surface) as a sparse octree,\n"
+    "with each surface's compiled function (for render --exact).\n"
     "\n"
     "  -o, --output OUT.oct   output file (written atomically: all or nothing)\n"
     "  --levels N             octree levels: a 2^N grid over the cube enclosing the\n"
@@ -37,6 +39,9 @@ static const char help_text[] =
     "                         |f(centre)| exceeds the gradient bound (Kalra-Barr)\n"
     "  --threads N            worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: the number of\n"
     "                         cores, at most " LIMIT_STR(THREADS_DEFAULT_MAX) ")\n"
+    "  --shell-only           store only the tree and the surface functions, no\n"
+    "                         per-voxel normals and planes (much smaller; the file\n"
+    "                         renders with render --exact only)\n"
     "  -q, --quiet            no progress bar and no summary\n"
     "  -h, --help             this text\n"
     "  --version              print the version and exit\n"
@@ -100,7 +105,7 @@ int main(int argc, char **argv)
     const char *scene_path = NULL, *out_path = NULL;
     long levels = DEFAULT_LEVELS, threads = sysconf(_SC_NPROCESSORS_ONLN);
     build_method method = BUILD_INTERVAL;
-    int quiet = 0;
+    int quiet = 0, shell_only = 0;
     if (threads < 1)
         threads = 1;
     if (threads > THREADS_DEFAULT_MAX)
@@ -118,6 +123,8 @@ int main(int argc, char **argv)
             return EXIT_OK;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             quiet = 1;
+        } else if (!strcmp(a, "--shell-only")) {
+            shell_only = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!has_value)
                 return diag_usage_error(usage_text, "option '%s' needs a file name", a);
@@ -161,6 +168,7 @@ int main(int argc, char **argv)
     scene *sc = NULL;
     oct_writer *w = NULL;
     atomic_file *af = NULL;
+    unsigned char *function = NULL;
     double t0 = now_seconds();
     scene_error serr;
     if (scene_load(scene_path, &sc, &serr) != 0) {
@@ -176,6 +184,17 @@ int main(int argc, char **argv)
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
     build_writer_params(sc, (unsigned)levels, palette, &wp);
+    /* every file carries the surfaces' whole tapes (format 1.1), for --exact */
+    const tape *tapes[OCT_MAX_SURFACES];
+    for (size_t s = 0; s < sc->nsurfaces; s++)
+        tapes[s] = &sc->surfaces[s].tape;
+    int trc = tape_io_encode(tapes, (unsigned)sc->nsurfaces, &function, &wp.function_size);
+    if (trc != TAPE_OK) {
+        diag_path_error(scene_path, "%s", tape_strerror(trc));
+        goto done;
+    }
+    wp.function = function;
+    wp.flags = shell_only ? OCT_FLAG_SHELL_ONLY : 0;
     oct_err err = oct_writer_create(&wp, &w);
     if (err != OCT_OK) {
         diag_path_error(scene_path, "%s", oct_strerror(err));
@@ -183,7 +202,7 @@ int main(int argc, char **argv)
     }
 
     progress pr = {!quiet && diag_stderr_is_tty(), -1};
-    build_params bp = {(unsigned)levels, method, (unsigned)threads, show_progress, &pr};
+    build_params bp = {(unsigned)levels, method, (unsigned)threads, show_progress, &pr, shell_only};
     build_stats st;
     err = build_octree(sc, &bp, w, &st);
     if (err != OCT_OK) {
@@ -215,6 +234,7 @@ int main(int argc, char **argv)
 done:
     atomic_file_abort(af);
     oct_writer_free(w);
+    free(function);
     scene_free(sc);
     return status;
 }

@@ -118,7 +118,8 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
             continue;
         if (retest) { /* records made below, all together */
             child[np] = (uint8_t)i;
-            surf[np] = (uint8_t)voxel_surface(wk, cidx, centre, &nw[np]);
+            surf[np] = (uint8_t)(c->par->shell_only ? shell_surface(wk, cidx, centre) /* --shell-only */
+                                                    : voxel_surface(wk, cidx, centre, &nw[np]));
             np++;
             mask |= (uint8_t)(1u << i);
         } else if (depth + 1 == c->levels) {

@@ -56,7 +56,8 @@ static const char help_text[] =
     "                      with one integer conversion, e.g. frame_%04d.png\n"
     "  --trust             skip the file's CRC-32 checks (a fixed cost per file); the\n"
     "                      structure is still validated in full\n"
-    "  --info              print a summary of FILE.oct\n"
+    "  --info              print a summary of FILE.oct (format version, flags,\n"
+    "                      tree, stored function, shard fields)\n"
     "  -q                  no per-view timing lines\n"
     "  --version           print the version and exit\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
@@ -297,14 +298,14 @@ static int load_views_file(const render_args *o, const views_view *base, char **
  * or the exit status. */
 static int open_tree(const render_args *o, oct_file **file)
 {
-    uint64_t off = 0;
-    oct_err err = oct_open(o->oct_path, o->trust ? OCT_OPEN_TRUST : 0u, file, &off);
+    oct_fault fault;
+    oct_err err = oct_open_fault(o->oct_path, o->trust ? OCT_OPEN_TRUST : 0u, file, &fault);
     if (err != OCT_OK) {
         if (err == OCT_EIO)
             diag_path_error(o->oct_path, "%s", strerror(errno));
-        else if (off)
-            diag_path_error(o->oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
-                            (unsigned long long)off);
+        else if (fault.offset) /* what: the broken rule, without "corrupt: " */
+            diag_path_error(o->oct_path, "corrupt: %s at offset %llu", fault.what,
+                            (unsigned long long)fault.offset);
         else
             diag_path_error(o->oct_path, "%s", oct_strerror(err));
         return EXIT_RUNTIME;
@@ -496,6 +497,11 @@ int main(int argc, char **argv)
         status = open_tree(&o, &file);
     if (status != EXIT_OK || (!o.views_path && !o.base.out))
         goto done; /* an error, or --info only */
+    if (oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) { /* only the function can place hits */
+        diag_path_error(o.oct_path, "stores no normals (rasterized with --shell-only): use --exact");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
     const oct_tree *tree = oct_get_tree(file);
     if (o.split > (long)tree->levels) {
         char msg[512];

@@ -1,6 +1,7 @@
 /* Tests for render/exact_scene and `--exact` through the traversal: images
  * of small scenes rasterized in memory against the exact reference caster
- * (bench/refcast) within the issue's targets; every traversal
+ * (bench/refcast) within the issue's targets, with the tapes the files
+ * store (format 1.1); every traversal
  * implementation gives the same hits; roots on voxel faces; the nearest
  * root of several surfaces; a function undefined on part of the grid; the
  * coarse cells' candidate lists and pruned tapes. */
@@ -18,9 +19,11 @@
 #include "bench/compare.h"
 #include "bench/refcast.h"
 #include "common/expr/scene.h"
+#include "common/expr/tape_io.h"
 #include "rasterize/build.h"
 #include "render/exact_scene.h"
 #include "render/frame.h"
+#include "render/stored_tapes.h"
 #include "render/trace_impl.h"
 
 typedef struct built {
@@ -29,7 +32,7 @@ typedef struct built {
     size_t size;
     oct_file *file;
     const oct_tree *tree;
-    tape *tapes;
+    stored_tapes st; /* the file's own tapes, as render loads them */
     exact_scene es;
 } built;
 
@@ -41,9 +44,15 @@ static void build(const char *text, unsigned levels, unsigned depth, built *b)
     float palette[3 * OCT_MAX_SURFACES];
     oct_writer_params wp;
     build_writer_params(b->sc, levels, palette, &wp);
+    const tape *tp[OCT_MAX_SURFACES];
+    for (size_t s = 0; s < b->sc->nsurfaces; s++)
+        tp[s] = &b->sc->surfaces[s].tape;
+    unsigned char *fn = NULL;
+    assert_int_equal(tape_io_encode(tp, (unsigned)b->sc->nsurfaces, &fn, &wp.function_size), TAPE_OK);
+    wp.function = fn;
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {levels, BUILD_INTERVAL, 2, NULL, NULL};
+    build_params bp = {levels, BUILD_INTERVAL, 2, NULL, NULL, 0};
     build_stats st;
     assert_int_equal(build_octree(b->sc, &bp, w, &st), OCT_OK);
     FILE *mem = open_memstream(&b->bytes, &b->size);
@@ -52,20 +61,19 @@ static void build(const char *text, unsigned levels, unsigned depth, built *b)
     assert_int_equal(oct_writer_finish(w, mem, &n), OCT_OK);
     assert_int_equal(fclose(mem), 0);
     oct_writer_free(w);
+    free(fn);
     uint64_t off = 0;
     assert_int_equal(oct_open_memory(b->bytes, b->size, 0, &b->file, &off), OCT_OK);
     b->tree = oct_get_tree(b->file);
-    b->tapes = calloc(b->sc->nsurfaces, sizeof *b->tapes);
-    assert_non_null(b->tapes);
-    for (size_t s = 0; s < b->sc->nsurfaces; s++)
-        b->tapes[s] = b->sc->surfaces[s].tape;
-    assert_int_equal(exact_scene_init(&b->es, b->tree, b->tapes, depth), 0);
+    assert_int_equal(stored_tapes_load(b->file, &b->st), STORED_TAPES_OK);
+    assert_int_equal(b->st.count, b->sc->nsurfaces);
+    assert_int_equal(exact_scene_init(&b->es, b->tree, b->st.tapes, depth), 0);
 }
 
 static void built_free(built *b)
 {
     exact_scene_free(&b->es);
-    free(b->tapes);
+    stored_tapes_free(&b->st);
     oct_close(b->file);
     free(b->bytes);
     scene_free(b->sc);
