@@ -119,9 +119,11 @@ typedef struct seg {
     unsigned depth;
 } seg;
 
-double exact_first_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                        int *kind)
+double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const exact_line *l,
+                        double a, double b, int *kind)
 {
+    if (!cull)
+        cull = t;
     seg stack[MAX_DEPTH + 2];
     int top = 0;
     stack[top++] = (seg){a, b, 0};
@@ -132,7 +134,7 @@ double exact_first_root(const tape *t, exact_scratch *w, const exact_line *l, do
         interval box[3];
         segment_box(l, s.a, s.b, box);
         unsigned flags = 0;
-        const interval F = tape_eval_interval(t, box, w->islots, &flags);
+        const interval F = tape_eval_interval(cull, box, w->islots, &flags);
         /* F encloses f wherever f is defined (flagged or not), and the NaN
          * interval means defined nowhere: either way no surface point here */
         if (interval_is_nan(F) || F.lo > 0.0 || F.hi < 0.0)

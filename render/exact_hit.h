@@ -41,7 +41,10 @@ enum {
 
 /* The first root of g(t) = f(o + t d) for t in [a, b] (a <= b, both finite),
  * or +inf when there is none; *kind (may be NULL) receives EXACT_ROOT or
- * EXACT_TOUCH on a hit.
+ * EXACT_TOUCH on a hit. `cull` (NULL: t) is the tape whose interval drops
+ * segments: t or one whose interval evaluation encloses t's on the boxes
+ * tested (a tape_prune_const of t for a box holding them, however coarse its
+ * `tiny`); the derivative and every point value come from t.
  *
  * Front-to-back bisection: a segment is dropped when the interval of f over
  * the box its points span (outward-rounded hull of its ends) excludes 0 or
@@ -58,8 +61,8 @@ enum {
  * touch at its midpoint if g is finite at both ends, and nothing when g is
  * undefined (NaN) or infinite at an end: where f is undefined there is no
  * surface (docs/evaluation.md), and a pole is none either. */
-double exact_first_root(const tape *t, exact_scratch *w, const exact_line *ray, double a, double b,
-                        int *kind);
+double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const exact_line *ray,
+                        double a, double b, int *kind);
 
 /* The unit normal at p: grad f(p) normalised, turned to face against d;
  * -d/|d| where the gradient is zero or not finite. */

@@ -13,7 +13,9 @@ typedef struct builder {
     uint32_t nsurf;
     uint32_t cap_cells, cap_cand;
     size_t n_insn, cap_insn, n_konst, cap_konst;
-    uint64_t *insn_off, *konst_off; /* per candidate; UINT64_MAX: the whole tape */
+    struct {
+        uint64_t exact[2], cull[2]; /* insn, konst pool offsets; UINT64_MAX: the whole tape */
+    } *off;                         /* per candidate */
     interval *slots;
     tape_insn *tmp_insn;
     tape_const *tmp_konst;
@@ -49,12 +51,46 @@ static void cell_box(const exact_scene *es, const uint32_t c[3], uint32_t size, 
     }
 }
 
+/* t pruned with `tiny` for the box whose slot intervals b->slots holds,
+ * appended to the pools (*off: its offsets, fixed up once they stop
+ * moving), or t itself (off UINT64_MAX) when pruning saves not a quarter. */
+static int store_pruned(builder *b, const tape *t, unsigned flags, double tiny, tape *out,
+                        uint64_t off[2], uint64_t *insns)
+{
+    exact_scene *es = b->es;
+    tape p;
+    tape_prune_const(t, b->slots, flags, isfinite(tiny) ? tiny : -1.0, b->tmp_insn, b->tmp_konst,
+                     b->tmp_scratch, &p);
+    if ((uint64_t)p.n * 4 > (uint64_t)t->n * 3) {
+        *out = *t;
+        out->owned = 0;
+        off[0] = off[1] = UINT64_MAX;
+        *insns += t->n;
+        return 0;
+    }
+    if (grow((void **)&es->insn_pool, &b->cap_insn, b->n_insn + p.n, sizeof(tape_insn)) ||
+        grow((void **)&es->konst_pool, &b->cap_konst, b->n_konst + p.nconst, sizeof(tape_const)))
+        return -1;
+    memcpy(es->insn_pool + b->n_insn, p.insn, p.n * sizeof(tape_insn));
+    memcpy(es->konst_pool + b->n_konst, p.konst, p.nconst * sizeof(tape_const));
+    *out = p;
+    out->owned = 0;
+    off[0] = b->n_insn;
+    off[1] = b->n_konst;
+    b->n_insn += p.n;
+    b->n_konst += p.nconst;
+    *insns += p.n;
+    return 0;
+}
+
 /* Registers coarse cell c: every surface whose enclosure over the cell
- * may hold 0 becomes a candidate, with its tape pruned for the cell. Terms
- * narrower there than 2^-30 of f's spread over one voxel become constants
- * (their midpoint for the point evaluator: a root moves by about 2^-30 of
- * a voxel at most, far below the targets; the interval evaluators stay
- * sound). A pruned tape not a quarter shorter uses the whole one. */
+ * may hold 0 becomes a candidate with two tapes pruned for the cell. The
+ * exact one turns into constants only terms narrower there than 2^-30 of
+ * f's spread over one voxel (their midpoint for the point evaluator: a root
+ * moves by about 2^-30 of a voxel at most, far below the targets); the
+ * culling one, whose interval alone is used (to drop segments: sound for
+ * any tiny, tape.h), takes the rasterizer's 10^-3, so a far blob costs
+ * nothing there. */
 static int add_cell(builder *b, const uint32_t c[3])
 {
     exact_scene *es = b->es;
@@ -73,42 +109,22 @@ static int add_cell(builder *b, const uint32_t c[3])
         const interval F = tape_eval_interval(t, box, b->slots, &flags);
         if (interval_is_nan(F) || F.lo > 0.0 || F.hi < 0.0)
             continue; /* not here (exact_first_root's rule) */
-        size_t cc = b->cap_cand, need = (size_t)es->ncand + 1;
-        size_t ci = cc, ck = cc;
-        if (grow((void **)&es->cand, &cc, need, sizeof *es->cand) ||
-            grow((void **)&b->insn_off, &ci, need, sizeof *b->insn_off) ||
-            grow((void **)&b->konst_off, &ck, need, sizeof *b->konst_off))
+        size_t cc = b->cap_cand;
+        if (grow((void **)&es->cand, &cc, (size_t)es->ncand + 1, sizeof *es->cand))
             return -1;
-        if (ci != cc || ck != cc)
-            return -1; /* (same growth for the three: cannot happen) */
-        b->cap_cand = (uint32_t)cc;
+        size_t co = b->cap_cand;
+        if (grow((void **)&b->off, &co, (size_t)es->ncand + 1, sizeof *b->off))
+            return -1;
+        b->cap_cand = (uint32_t)(cc < co ? cc : co);
         exact_cand *k = &es->cand[es->ncand];
         k->surface = s;
-        double tiny = ldexp(F.hi - F.lo, -(int)(L - D) - 30);
-        tape p;
-        tape_prune_const(t, b->slots, flags, isfinite(tiny) ? tiny : -1.0, b->tmp_insn,
-                         b->tmp_konst, b->tmp_scratch, &p);
+        const double per_voxel = ldexp(F.hi - F.lo, -(int)(L - D));
         es->whole_insns += t->n;
-        if ((uint64_t)p.n * 4 > (uint64_t)t->n * 3) {
-            k->t = *t;
-            k->t.owned = 0;
-            b->insn_off[es->ncand] = UINT64_MAX;
-            es->pruned_insns += t->n;
-        } else {
-            if (grow((void **)&es->insn_pool, &b->cap_insn, b->n_insn + p.n, sizeof(tape_insn)) ||
-                grow((void **)&es->konst_pool, &b->cap_konst, b->n_konst + p.nconst,
-                     sizeof(tape_const)))
-                return -1;
-            memcpy(es->insn_pool + b->n_insn, p.insn, p.n * sizeof(tape_insn));
-            memcpy(es->konst_pool + b->n_konst, p.konst, p.nconst * sizeof(tape_const));
-            k->t = p;
-            k->t.owned = 0;
-            b->insn_off[es->ncand] = b->n_insn;
-            b->konst_off[es->ncand] = b->n_konst;
-            b->n_insn += p.n;
-            b->n_konst += p.nconst;
-            es->pruned_insns += p.n;
-        }
+        if (store_pruned(b, t, flags, ldexp(per_voxel, -30), &k->t, b->off[es->ncand].exact,
+                         &es->pruned_insns) ||
+            store_pruned(b, t, flags, 1e-3 * per_voxel, &k->cull, b->off[es->ncand].cull,
+                         &es->cull_insns))
+            return -1;
         es->ncand++;
     }
     const uint32_t dim = UINT32_C(1) << D;
@@ -175,14 +191,17 @@ int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, u
         es->first = calloc(1, sizeof *es->first);
         rc = es->first ? 0 : -1;
     }
-    if (rc == 0)
-        for (uint32_t k = 0; k < es->ncand; k++)
-            if (b.insn_off[k] != UINT64_MAX) {
-                es->cand[k].t.insn = es->insn_pool + b.insn_off[k];
-                es->cand[k].t.konst = es->konst_pool + b.konst_off[k];
-            }
-    free(b.insn_off);
-    free(b.konst_off);
+    for (uint32_t k = 0; rc == 0 && k < es->ncand; k++) {
+        if (b.off[k].exact[0] != UINT64_MAX) {
+            es->cand[k].t.insn = es->insn_pool + b.off[k].exact[0];
+            es->cand[k].t.konst = es->konst_pool + b.off[k].exact[1];
+        }
+        if (b.off[k].cull[0] != UINT64_MAX) {
+            es->cand[k].cull.insn = es->insn_pool + b.off[k].cull[0];
+            es->cand[k].cull.konst = es->konst_pool + b.off[k].cull[1];
+        }
+    }
+    free(b.off);
     free(b.slots);
     free(b.tmp_insn);
     free(b.tmp_konst);
@@ -242,7 +261,8 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
     for (uint32_t k = es->first[slot]; k < es->first[slot + 1]; k++) {
         if (!(a <= b))
             break;
-        const double t = exact_first_root(&es->cand[k].t, &w->scratch, &l, a, b, NULL);
+        const exact_cand *c = &es->cand[k];
+        const double t = exact_first_root(&c->t, &c->cull, &w->scratch, &l, a, b, NULL);
         if (t < best) {
             best = t;
             best_k = k;

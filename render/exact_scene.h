@@ -13,14 +13,16 @@
 #include "render/exact_hit.h"
 #include "render/trace.h"
 
-/* Coarse depth: measured on blobs_a, csg and manyblobs (docs/perf-log.md). */
+/* Coarse depth (docs/perf-log.md, "render --exact"). */
 #define EXACT_CELL_DEPTH 5
 #define EXACT_CELL_MAX_DEPTH 7 /* 8^7 map entries: 8 MiB */
 
 /* One surface in one coarse cell. */
 typedef struct exact_cand {
     uint32_t surface; /* palette index */
-    tape t;           /* pruned for the cell; arrays in the scene's pools */
+    tape t;           /* pruned for the cell, as exact as the whole tape (points,
+                         derivative); arrays in the scene's pools */
+    tape cull;        /* pruned coarsely, for the interval that drops segments */
 } exact_cand;
 
 typedef struct exact_scene {
@@ -31,7 +33,7 @@ typedef struct exact_scene {
     exact_cand *cand;
     uint32_t ncells, ncand;
     uint32_t max_n;      /* most instructions of any tape (scratch size) */
-    uint64_t whole_insns, pruned_insns; /* statistics: sum over candidates */
+    uint64_t whole_insns, pruned_insns, cull_insns; /* statistics: sum over candidates */
     double h;            /* world units per voxel: edge / 2^L */
     tape_insn *insn_pool;
     tape_const *konst_pool;

@@ -254,7 +254,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
                 exact_worker_free(&sh.exact[i]);
             free(sh.exact);
             stats->rays = stats->hits = stats->steps = 0;
-            return ENOMEM;
+            return -1;
         }
     }
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;

@@ -40,7 +40,7 @@ typedef struct frame_stats {
 } frame_stats;
 
 /* Returns 0, or an errno value when a thread could not be started (the
- * frame is then rendered by the threads that did start); ENOMEM before
+ * frame is then rendered by the threads that did start); -1 before
  * rendering anything when --exact's per-thread scratch cannot be had. */
 int frame_render(const frame_job *job, frame_stats *stats);
 

@@ -17,6 +17,7 @@
 #include "common/test_hooks.h"
 #include "common/version.h"
 #include "format/oct.h"
+#include "render/exact_load.h"
 #include "render/frame.h"
 #include "render/shade.h"
 #include "render/trace.h"
@@ -25,7 +26,7 @@
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
-    "              [--split K] [--refine] [--light X,Y,Z] [--background R,G,B]\n"
+    "              [--split K] [--refine] [--exact] [--light X,Y,Z] [--background R,G,B]\n"
     "              [--beam N] [--threads N] [--trust] [--info] [-q]\n"
     "       render FILE.oct --views VIEWS_FILE [options]\n"
     "       render FILE.oct -o 'frame_%04d.png' --orbit N [options]\n"
@@ -44,6 +45,9 @@ static const char help_text[] =
     "                      a name ending in .pfm gets float normals (3-channel PFM)\n"
     "  --split K           octree depth where the empty-space skipping stops (default: levels)\n"
     "  --refine            intersect the voxels' stored planes for sub-voxel depth\n"
+    "  --exact             place each hit at the first root of the file's stored\n"
+    "                      functions in the occupied voxels the ray crosses: exact\n"
+    "                      depth, normals (the gradient) and colour (format 1.1)\n"
     "  --beam N            walk N x N pixel blocks (and their 4 x 4 sub-blocks) as\n"
     "                      pyramids first, to skip what no ray of them can hit\n"
     "                      (default 32; 0: off; same image)\n"
@@ -244,7 +248,8 @@ static int parse_args(int argc, char **argv, render_args *o)
             o->oct_path = a;
             continue;
         }
-        int *flag = strcmp(a, "--refine") == 0 ? &o->refine
+        int *flag = views_flag(&o->base, a) ? views_flag(&o->base, a)
+                    : strcmp(a, "--refine") == 0 ? &o->refine
                     : strcmp(a, "--info") == 0 ? &o->info
                     : strcmp(a, "--trust") == 0 ? &o->trust
                     : strcmp(a, "-q") == 0     ? &o->quiet
@@ -403,13 +408,14 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
 /* Renders one view and writes its images; adds its time and rays to the
  * totals. Returns EXIT_OK or EXIT_RUNTIME. */
 static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
-                       const camera *cam, const render_buffers *buf, double *total_ms,
-                       uint64_t *total_rays)
+                       const camera *cam, const render_buffers *buf, const exact_scene *es,
+                       double *total_ms, uint64_t *total_rays)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
     job.tree = tree;
     job.cam = cam;
+    job.exact = v->exact ? es : NULL;
     job.opts.split = o->split < 0 ? tree->levels : (unsigned)o->split;
     job.opts.refine = o->refine;
     job.shade.ambient = 0.15f;
@@ -429,7 +435,10 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
         job.progress = progress_bar;
     frame_stats st;
     double t0 = now_ms();
-    frame_render(&job, &st);
+    if (frame_render(&job, &st) < 0) {
+        diag_error("out of memory for --exact's scratch");
+        return EXIT_RUNTIME;
+    }
     double ms = now_ms() - t0;
     *total_ms += ms;
     *total_rays += st.rays;
@@ -458,12 +467,13 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
 
 /* The view loop: every view in turn, then the totals line. */
 static int render_views(const oct_tree *tree, const render_args *o, const views_view *list,
-                        size_t nviews, const camera *cams, const render_buffers *buf)
+                        size_t nviews, const camera *cams, const render_buffers *buf,
+                        const exact_scene *es)
 {
     double total_ms = 0.0;
     uint64_t total_rays = 0;
     for (size_t k = 0; k < nviews; k++) {
-        int st = render_view(tree, o, &list[k], &cams[k], buf, &total_ms, &total_rays);
+        int st = render_view(tree, o, &list[k], &cams[k], buf, es, &total_ms, &total_rays);
         if (st != EXIT_OK)
             return st;
     }
@@ -490,6 +500,8 @@ int main(int argc, char **argv)
     render_buffers buf = {NULL, NULL, NULL, NULL};
     camera *cams = NULL;
     oct_file *file = NULL;
+    exact_loaded exact;
+    memset(&exact, 0, sizeof exact);
 
     if (o.views_path)
         status = load_views_file(&o, &o.base, &views_text, &list, &nviews);
@@ -497,8 +509,20 @@ int main(int argc, char **argv)
         status = open_tree(&o, &file);
     if (status != EXIT_OK || (!o.views_path && !o.base.out))
         goto done; /* an error, or --info only */
-    if (oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) { /* only the function can place hits */
+    int any_exact = o.base.exact, all_exact = nviews ? 1 : o.base.exact;
+    for (size_t k = 0; k < nviews; k++) {
+        any_exact |= list[k].exact;
+        all_exact &= list[k].exact;
+    }
+    if ((oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) && !all_exact) {
+        /* only the function can place hits */
         diag_path_error(o.oct_path, "stores no normals (rasterized with --shell-only): use --exact");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
+    const char *why = NULL;
+    if (any_exact && exact_load(file, &exact, &why) != 0) {
+        diag_path_error(o.oct_path, "%s", why);
         status = EXIT_RUNTIME;
         goto done;
     }
@@ -520,9 +544,10 @@ int main(int argc, char **argv)
         long n = sysconf(_SC_NPROCESSORS_ONLN);
         o.threads = n < 1 ? 1 : n > THREADS_DEFAULT_MAX ? THREADS_DEFAULT_MAX : n;
     }
-    status = render_views(tree, &o, list, nviews, cams, &buf);
+    status = render_views(tree, &o, list, nviews, cams, &buf, any_exact ? &exact.es : NULL);
 
 done:
+    exact_loaded_free(&exact);
     free(buf.rgb);
     free(buf.depth);
     free(buf.nrm);

@@ -31,6 +31,11 @@ int views_is_option(const char *name)
     return 0;
 }
 
+int *views_flag(views_view *v, const char *name)
+{
+    return strcmp(name, "--exact") == 0 ? &v->exact : NULL;
+}
+
 int views_apply(views_view *v, const char *name, const char *value, char *msg, size_t n)
 {
     parse_err e = PARSE_OK;
@@ -99,6 +104,11 @@ int views_parse(char *text, const views_view *base, views_view **out, size_t *co
         for (char *tok = strtok_r(line, " \t\r\v\f", &save); tok;
              tok = strtok_r(NULL, " \t\r\v\f", &save)) {
             any = 1;
+            int *flag = views_flag(&v, tok);
+            if (flag) {
+                *flag = 1;
+                continue;
+            }
             if (!views_is_option(tok)) {
                 snprintf(msg, sizeof msg, "unknown option '%s'", tok);
                 line_bad = 1;

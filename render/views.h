@@ -5,7 +5,7 @@
  * skipped. A line is whitespace-separated options with the same names and
  * value syntax as the command line:
  *     -o OUT.png [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z] [--fov DEG]
- *     [--size WxH] [--depth OUT.pfm] [--normals OUT.png]
+ *     [--size WxH] [--depth OUT.pfm] [--normals OUT.png] [--exact]
  * Options a line leaves out take the command line's values (or the
  * defaults). Paths cannot contain whitespace or '#'. Every line needs -o.
  * Relative paths are taken as they are (relative to the working directory). */
@@ -22,6 +22,7 @@ typedef struct views_view {
     const char *out;     /* PNG path (required) */
     const char *depth;   /* PFM path or NULL */
     const char *normals; /* PNG path or NULL */
+    int exact;           /* --exact: hits placed by the stored functions */
     unsigned line;       /* views-file line (1-based), 0 for the command line */
 } views_view;
 
@@ -31,6 +32,8 @@ void views_defaults(views_view *v);
 
 /* 1 when `name` is a per-view option that takes a value. */
 int views_is_option(const char *name);
+/* The field of a per-view flag (no value: --exact) in v, or NULL. */
+int *views_flag(views_view *v, const char *name);
 
 /* Applies option `name` with `value` to v. `value` must outlive v (paths
  * are not copied). Returns 0, or -1 with a message in msg (size n). */

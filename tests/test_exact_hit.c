@@ -41,7 +41,7 @@ static double root(fixture *f, const double o[3], const double d[3], double a, d
     memcpy(l.o, o, sizeof l.o);
     memcpy(l.d, d, sizeof l.d);
     *kind = 0;
-    return exact_first_root(&f->sc->surfaces[0].tape, &f->w, &l, a, b, kind);
+    return exact_first_root(&f->sc->surfaces[0].tape, NULL, &f->w, &l, a, b, kind);
 }
 
 /* |got - want| within k ulps of want */

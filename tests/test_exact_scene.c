@@ -324,9 +324,12 @@ static void test_cells_prune(void **state)
         assert_true(b.es.first[c + 1] - b.es.first[c] <= 1);
     assert_true(b.es.whole_insns > 100);
     if (getenv("EXACT_VERBOSE"))
-        printf("cells %u cand %u insns %llu -> %llu\n", b.es.ncells, b.es.ncand,
-               (unsigned long long)b.es.whole_insns, (unsigned long long)b.es.pruned_insns);
+        printf("cells %u cand %u insns %llu -> %llu, cull %llu\n", b.es.ncells, b.es.ncand,
+               (unsigned long long)b.es.whole_insns, (unsigned long long)b.es.pruned_insns,
+               (unsigned long long)b.es.cull_insns);
     assert_true(b.es.pruned_insns * 2 < b.es.whole_insns);
+    /* the culling tapes, pruned with the rasterizer's threshold, are shorter still */
+    assert_true(b.es.cull_insns < b.es.pruned_insns);
     built_free(&b);
 }
 
