@@ -20,7 +20,7 @@ typedef struct atomic_file atomic_file;
 /* Creates the temporary file. Returns NULL with errno set on failure. */
 atomic_file *atomic_file_open(const char *target_path);
 
-/* The stream to write to; valid until commit or abort. */
+/* The stream to write to (seekable); valid until commit or abort. */
 FILE *atomic_file_stream(atomic_file *af);
 
 /* Writes n bytes, honouring the fault hook; returns 0 or -1 with errno. */

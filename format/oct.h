@@ -22,6 +22,11 @@
  * voxel centre along the normal, in voxel edges). When the scene has more than
  * one surface, a parallel uint8 array names each voxel's surface, which
  * indexes the palette.
+ *
+ * Format 1.1 adds a FUNCTION section (each surface's tape, validated in
+ * place: oct_get_function; common/expr/tape_io.c makes tapes of it), the
+ * SHELL_ONLY flag (no voxel records) and shard fields. The writer writes 1.0
+ * unless one of them is used.
  */
 #ifndef OCT_H
 #define OCT_H

@@ -52,7 +52,7 @@ static void build(const char *text, unsigned levels, unsigned depth, built *b)
     wp.function = fn;
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {levels, BUILD_INTERVAL, 2, NULL, NULL, 0};
+    build_params bp = {.levels = levels, .method = BUILD_INTERVAL, .threads = 2};
     build_stats st;
     assert_int_equal(build_octree(b->sc, &bp, w, &st), OCT_OK);
     FILE *mem = open_memstream(&b->bytes, &b->size);

@@ -338,6 +338,45 @@ static void test_sweeps_1_1(void **state)
     }
 }
 
+/* The 1.1 writer (the function's copy, a shell-only file's surfaces without
+ * records) fails cleanly at every allocation, and otherwise writes the
+ * same bytes. */
+static void test_allocation_failures_1_1(void **state)
+{
+    (void)state;
+    for (int shell = 0; shell < 2; shell++) {
+        test_tree t;
+        unsigned char *good;
+        size_t good_len;
+        test_fn_small_file(&good, &good_len, &t, shell ? OCT_FLAG_SHELL_ONLY : 0);
+        size_t fsize;
+        unsigned char *fn = test_fn_section(2, &fsize);
+        oct_writer_params p = {0};
+        p.flags = shell ? OCT_FLAG_SHELL_ONLY : 0;
+        p.function = fn;
+        p.function_size = fsize;
+        for (long n = 1;; n++) {
+            unsigned char *out = NULL;
+            size_t len = 0;
+            oct__alloc_fail_after(n, 1);
+            oct_err rc = test_tree_write_1_1(&t, &p, &out, &len);
+            oct__alloc_fail_after(0, 0);
+            if (rc == OCT_OK) {
+                assert_int_equal(len, good_len);
+                assert_memory_equal(out, good, len);
+                free(out);
+                break;
+            }
+            free(out);
+            assert_int_equal(rc, OCT_ENOMEM);
+            assert_true(n < 1000);
+        }
+        free(fn);
+        free(good);
+        test_tree_free(&t);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -346,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_header_fields_1_1),
         cmocka_unit_test(test_shard_fields),
         cmocka_unit_test(test_sweeps_1_1),
+        cmocka_unit_test(test_allocation_failures_1_1),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

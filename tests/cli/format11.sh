@@ -22,6 +22,15 @@ expect_exit 0 "$BIN/render" --info "$T/shell.oct"
 grep -q '^flags: *shell-only' "$OUT" || fail "--info shell-only"
 grep -v -e '^flags' -e '^file bytes' -e '^bytes/voxel' "$OUT" > "$T/shell.info"
 cmp -s "$T/full.info" "$T/shell.info" || fail "--shell-only changed the tree: $(diff "$T/full.info" "$T/shell.info")"
+# ... byte for byte: the NODES (entry at 136) and SURFACES (entry at 184) sections
+section() { # FILE ENTRY_OFFSET -> the section's bytes on stdout
+    off=$(od -An -tu8 -j "$2" -N 8 "$1" | tr -d ' '); len=$(od -An -tu8 -j $(($2 + 8)) -N 8 "$1" | tr -d ' ')
+    tail -c +$((off + 1)) "$1" | head -c "$len"
+}
+for e in 136 184; do
+    section "$T/full.oct" $e > "$T/a.sec"; section "$T/shell.oct" $e > "$T/b.sec"
+    [ -s "$T/a.sec" ] && cmp -s "$T/a.sec" "$T/b.sec" || fail "--shell-only changed the section at entry $e"
+done
 # well under a byte a voxel: the nodes, the surface indices (two surfaces), the function
 voxels=$(sed -n 's/^voxels: *//p' "$OUT")
 bytes=$(wc -c < "$T/shell.oct")
