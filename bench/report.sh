@@ -26,18 +26,35 @@ FILENAME ~ /refcast.csv$/ && FNR > 1 && $7 == "std" { ref[$6] = $9; size = $8 }
 FILENAME ~ /render.csv$/ && FNR > 1 && $8 == "std" { k = $6 SUBSEP $7 SUBSEP $10
     ms[k] = $11; mr[k] = $12; me[k] = $13; p9[k] = $14; hm[k] = $16; nm[k] = $17; np[k] = $18; sz = $9 }
 END {
-    print "| scene | levels | rasterize s | voxels | MB | bytes/voxel | peak RSS MiB | render ms (Mrays/s) | --refine ms | depth err mean / p99 | --refine mean / p99 | hit/miss % (--refine) | normal err mean / p99 ° | refcast s |"
-    print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    print "| scene | levels | rasterize s | voxels | MB | bytes/voxel | peak RSS MiB | render ms (Mrays/s) | --refine ms | --exact ms (x plain) | depth err mean / p99 | --refine mean / p99 | --exact mean / p99 | hit/miss % (--refine, --exact) | normal err mean / p99 ° | --exact normal p99 ° | refcast s |"
+    print "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     for (i = 0; i < n; i++) {
         s = order[i]; best = -1
         for (L = 6; L <= 12; L++) if ((s, L) in rs && (best < 0 || (L <= 10 && L > best))) best = L
-        a = s SUBSEP best SUBSEP "plain"; b = s SUBSEP best SUBSEP "refine"
-        printf "| %s | %d | %.2f | %d | %.1f | %.2f | %.1f | %.1f (%.1f) | %.1f | %.3g / %.3g | %.3g / %.3g | %.3f (%.3f) | %.2f / %.2f | %.1f |\n",
+        a = s SUBSEP best SUBSEP "plain"; b = s SUBSEP best SUBSEP "refine"; x = s SUBSEP best SUBSEP "exact"
+        printf "| %s | %d | %.2f | %d | %.1f | %.2f | %.1f | %.1f (%.1f) | %.1f | %.1f (%.2f) | %.3g / %.3g | %.3g / %.3g | %.3g / %.3g | %.3f (%.3f, %.3f) | %.2f / %.2f | %.3g | %.1f |\n",
             s, best, rs[s, best], rv[s, best], rb[s, best] / 1e6, rbv[s, best], rm[s, best] / 1024,
-            ms[a], mr[a], ms[b], me[a], p9[a], me[b], p9[b], 100 * hm[a], 100 * hm[b], nm[a], np[a], ref[s] / 1000
+            ms[a], mr[a], ms[b], ms[x], (ms[a] > 0 ? ms[x] / ms[a] : 0), me[a], p9[a], me[b], p9[b],
+            me[x], p9[x], 100 * hm[a], 100 * hm[b], 100 * hm[x], nm[a], np[a], np[x], ref[s] / 1000
     }
     printf "\nRender and refcast images are %dx%d; the render columns use the default split.\n", sz, sz
 }' "$RES/rasterize.csv" "$RES/refcast.csv" "$RES/render.csv"
+echo
+echo "\`--exact\` time (ms, standard view) against octree levels: with exact hits the level is a speed knob."
+echo
+awk -F, 'FNR > 1 && $8 == "std" && $10 == "exact" { t[$6, $7] = $11; if (!($6 in seen)) { seen[$6] = 1; order[n++] = $6 } }
+END {
+    printf "| scene |"; for (L = 6; L <= 12; L++) printf " %d |", L; print " fastest level |"
+    printf "|---|"; for (L = 6; L <= 12; L++) printf "---|"; print "---|"
+    for (i = 0; i < n; i++) {
+        s = order[i]; best = -1; printf "| %s |", s
+        for (L = 6; L <= 12; L++) {
+            if ((s, L) in t) { printf " %.1f |", t[s, L]; if (best < 0 || t[s, L] < t[s, best]) best = L }
+            else printf " |"
+        }
+        printf " %d |\n", best
+    }
+}' "$RES/render.csv"
 echo
 echo "Rasterize cost against octree levels (slope of log time / log bytes against log 2^levels, levels >= 8):"
 echo

@@ -106,7 +106,7 @@ rasterize() { # SCENE LEVELS OUT.oct: one CSV row
 }
 
 # ---- render: REPS frames of every view in one mapping, median per view ----
-render_views() { # OCT SCENE LEVELS MODE(plain|refine) [--split K]: CSV rows
+render_views() { # OCT SCENE LEVELS MODE(plain|refine|exact) [--split K]: CSV rows
     oct=$1 s=$2 L=$3 mode=$4; shift 4
     vf="$WORK/views" ; : >"$vf"
     views "scenes/$s.scene" | while read -r name eye target up; do
@@ -118,7 +118,7 @@ render_views() { # OCT SCENE LEVELS MODE(plain|refine) [--split K]: CSV rows
             r=$((r + 1))
         done
     done
-    flag=""; [ "$mode" = refine ] && flag=--refine
+    flag=""; [ "$mode" = refine ] && flag=--refine; [ "$mode" = exact ] && flag=--exact
     "$BIN/render" "$oct" --views "$vf" $flag "$@" 2>"$WORK/vlog"
     vox=$(awk -v e="$(edge "scenes/$s.scene")" -v L="$L" 'BEGIN { printf "%.17g", e / 2 ^ L }')
     views "scenes/$s.scene" | while read -r name eye target up; do
@@ -150,6 +150,7 @@ for s in $SCENES; do
         rasterize "$s" "$L" "$oct"
         render_views "$oct" "$s" "$L" plain
         render_views "$oct" "$s" "$L" refine
+        render_views "$oct" "$s" "$L" exact
         case $s.$L in blobs_a.$FIG_LEVELS|blobs_b.$FIG_LEVELS) ;; *) rm -f "$oct" ;; esac
     done
 done

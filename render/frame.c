@@ -23,17 +23,26 @@ typedef struct frame_acc {
     double secondary_ns;
 } frame_acc;
 
+/* What the threads of a frame share and change. */
+typedef struct frame_sync {
+    atomic_uint_fast64_t next, done;
+    atomic_int changed; /* set when map_guard abandoned a thread's work */
+    pthread_mutex_t lock; /* guards the sums below */
+    frame_acc sum;
+    double thread_ns;
+    exact_worker *exact; /* with --exact: one per thread of a pass, else NULL */
+    atomic_uint next_exact;
+} frame_sync;
+
+/* What a thread reads while it renders: one per thread (a copy), so that
+ * with --exact its job carries that thread's own exact worker. */
 typedef struct frame_shared {
     const frame_job *job;
     trace_traverse_fn traverse;
     aa_probe *probes; /* centre rays, for the antialiasing pass; NULL without */
     int phase;        /* 0: centre rays; 1: samples where needed */
     uint32_t tiles_x, tiles_y;
-    atomic_uint_fast64_t next, done;
-    atomic_int changed; /* set when map_guard abandoned a thread's work */
-    pthread_mutex_t lock; /* guards the sums below */
-    frame_acc sum;
-    double thread_ns;
+    frame_sync *sync;
 } frame_shared;
 
 static double now_ns(void)
@@ -111,8 +120,10 @@ static void shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit
     const int shadow = job->shade.shadows && lam > 0.0;
     if (h->hit && (shadow || ao_count)) {
         const double t0 = job->timing ? now_ns() : 0.0;
-        double o[3];
-        if (!shadow_origin(job->tree, h, n, o))
+        double o[3], p[3];
+        for (int a = 0; a < 3; a++)
+            p[a] = job->cam->eye[a] + h->t * dir[a];
+        if (!(h->exact ? shadow_origin_at(job->tree, p, n, o) : shadow_origin(job->tree, h, n, o)))
             goto lit; /* no start off the surface: lit and open */
         if (shadow) {
             acc->shadow_rays++;
@@ -170,7 +181,7 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
         aa_probe *p = &sh->probes[px];
         p->hit = (uint8_t)h.hit;
         p->t = h.hit ? (float)h.t : INFINITY;
-        p->surface = h.hit && job->tree->surfaces ? job->tree->surfaces[h.voxel] : 0;
+        p->surface = shade_surface(job->tree, &h);
         for (int a = 0; a < 3; a++)
             p->n[a] = n[a];
         float f = (float)t_lo; /* rounded down: a start never late */
@@ -329,7 +340,7 @@ static void trace_sample(const frame_shared *sh, frame_acc *acc, const trace_eye
     shade_sample(sh, acc, &h, dir, i, j, k * per, per, per * na * na, rgb, p->n);
     p->hit = (uint8_t)h.hit;
     p->t = h.hit ? (float)h.t : INFINITY;
-    p->surface = h.hit && job->tree->surfaces ? job->tree->surfaces[h.voxel] : 0;
+    p->surface = shade_surface(job->tree, &h);
 }
 
 /* Pixel (i, j) again with samples (aa.h): the four corner samples of the
@@ -413,38 +424,47 @@ static void render_tile(const frame_shared *sh, frame_acc *acc, uint32_t tx, uin
                          bj + bs < j1 ? bj + bs : j1);
 }
 
-static void work(frame_shared *sh, int caller)
+static void work(const frame_shared *common, int caller)
 {
+    frame_shared mine = *common;
+    frame_shared *sh = &mine;
+    frame_sync *sy = sh->sync;
+    frame_job own; /* with --exact: the job with this thread's exact worker */
+    if (sy->exact) {
+        own = *sh->job;
+        own.opts.exact = &sy->exact[atomic_fetch_add(&sy->next_exact, 1)];
+        sh->job = &own;
+    }
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
     frame_acc acc;
     memset(&acc, 0, sizeof acc);
     const double t0 = sh->job->timing ? now_ns() : 0.0;
     for (;;) {
-        if (atomic_load_explicit(&sh->changed, memory_order_relaxed))
+        if (atomic_load_explicit(&sy->changed, memory_order_relaxed))
             break; /* another thread met the file changing: stop */
-        uint64_t t = atomic_fetch_add(&sh->next, 1);
+        uint64_t t = atomic_fetch_add(&sy->next, 1);
         if (t >= total)
             break;
         render_tile(sh, &acc, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x));
-        uint64_t d = atomic_fetch_add(&sh->done, 1) + 1;
+        uint64_t d = atomic_fetch_add(&sy->done, 1) + 1;
         if (caller && sh->phase == 0 && sh->job->progress)
             sh->job->progress(sh->job->progress_ctx, d, total);
         if (caller && sh->phase == 0)
             test_hooks_tile(d);
     }
     const double ns = sh->job->timing ? now_ns() - t0 : 0.0;
-    pthread_mutex_lock(&sh->lock);
-    sh->sum.rays += acc.rays;
-    sh->sum.hits += acc.hits;
-    sh->sum.steps += acc.steps;
-    sh->sum.aa_pixels += acc.aa_pixels;
-    sh->sum.aa_full += acc.aa_full;
-    sh->sum.shadow_rays += acc.shadow_rays;
-    sh->sum.ao_rays += acc.ao_rays;
-    sh->sum.secondary_steps += acc.secondary_steps;
-    sh->sum.secondary_ns += acc.secondary_ns;
-    sh->thread_ns += ns;
-    pthread_mutex_unlock(&sh->lock);
+    pthread_mutex_lock(&sy->lock);
+    sy->sum.rays += acc.rays;
+    sy->sum.hits += acc.hits;
+    sy->sum.steps += acc.steps;
+    sy->sum.aa_pixels += acc.aa_pixels;
+    sy->sum.aa_full += acc.aa_full;
+    sy->sum.shadow_rays += acc.shadow_rays;
+    sy->sum.ao_rays += acc.ao_rays;
+    sy->sum.secondary_steps += acc.secondary_steps;
+    sy->sum.secondary_ns += acc.secondary_ns;
+    sy->thread_ns += ns;
+    pthread_mutex_unlock(&sy->lock);
 }
 
 typedef struct work_arg {
@@ -464,7 +484,7 @@ static void guarded_work(frame_shared *sh, int caller)
 {
     work_arg w = {sh, caller};
     if (map_guard_run(work_fn, &w) != 0)
-        atomic_store(&sh->changed, 1);
+        atomic_store(&sh->sync->changed, 1);
 }
 
 static void *worker(void *arg)
@@ -478,8 +498,9 @@ static void *worker(void *arg)
 static int run_pass(frame_shared *sh, int phase)
 {
     sh->phase = phase;
-    atomic_store(&sh->next, 0);
-    atomic_store(&sh->done, 0);
+    atomic_store(&sh->sync->next, 0);
+    atomic_store(&sh->sync->done, 0);
+    atomic_store(&sh->sync->next_exact, 0);
     unsigned extra = sh->job->threads > 1 ? sh->job->threads - 1 : 0;
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;
     int rc = 0;
@@ -498,19 +519,54 @@ static int run_pass(frame_shared *sh, int phase)
     return rc;
 }
 
+/* One exact worker (scratch) for each thread of a pass; 0, or -1 when
+ * they cannot be had. */
+static int exact_workers_init(frame_sync *sy, const frame_job *job)
+{
+    if (!job->exact)
+        return 0;
+    const unsigned n = job->threads > 1 ? job->threads : 1;
+    sy->exact = calloc(n, sizeof *sy->exact);
+    unsigned k = 0;
+    while (sy->exact && k < n && exact_worker_init(&sy->exact[k], job->exact) == 0)
+        k++;
+    if (sy->exact && k == n)
+        return 0;
+    for (unsigned i = 0; sy->exact && i < k; i++)
+        exact_worker_free(&sy->exact[i]);
+    free(sy->exact);
+    sy->exact = NULL;
+    return -1;
+}
+
+static void exact_workers_free(frame_sync *sy, const frame_job *job)
+{
+    const unsigned n = job->threads > 1 ? job->threads : 1;
+    for (unsigned k = 0; sy->exact && k < n; k++)
+        exact_worker_free(&sy->exact[k]);
+    free(sy->exact);
+}
+
 int frame_render(const frame_job *job, frame_stats *stats)
 {
     pthread_once(&srgb_once, srgb_init);
+    memset(stats, 0, sizeof *stats);
+    frame_sync sy;
+    memset(&sy, 0, sizeof sy);
+    if (exact_workers_init(&sy, job) != 0)
+        return -1;
     frame_shared sh;
     memset(&sh, 0, sizeof sh);
     sh.job = job;
+    sh.sync = &sy;
     sh.traverse = job->traverse ? job->traverse : trace_impls[0].traverse;
     sh.tiles_x = (job->cam->width + FRAME_TILE - 1) / FRAME_TILE;
     sh.tiles_y = (job->cam->height + FRAME_TILE - 1) / FRAME_TILE;
-    atomic_init(&sh.next, 0);
-    atomic_init(&sh.done, 0);
-    atomic_init(&sh.changed, 0);
-    pthread_mutex_init(&sh.lock, NULL);
+    atomic_init(&sy.next, 0);
+    atomic_init(&sy.done, 0);
+    atomic_init(&sy.changed, 0);
+    atomic_init(&sy.next_exact, 0);
+    pthread_mutex_init(&sy.lock, NULL);
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     int rc = 0;
     if (job->aa > 1) {
@@ -519,24 +575,24 @@ int frame_render(const frame_job *job, frame_stats *stats)
             rc = ENOMEM; /* one ray a pixel */
     }
     int rc1 = run_pass(&sh, 0);
-    if (sh.probes && !atomic_load(&sh.changed)) {
+    if (sh.probes && !atomic_load(&sy.changed)) {
         int rc2 = run_pass(&sh, 1);
         if (!rc1)
             rc1 = rc2;
     }
     free(sh.probes);
-    pthread_mutex_destroy(&sh.lock);
-    memset(stats, 0, sizeof *stats);
-    stats->rays = (uint64_t)npx + sh.sum.rays;
-    stats->hits = sh.sum.hits;
-    stats->steps = sh.sum.steps;
-    stats->aa_pixels = sh.sum.aa_pixels;
-    stats->aa_full = sh.sum.aa_full;
-    stats->shadow_rays = sh.sum.shadow_rays;
-    stats->ao_rays = sh.sum.ao_rays;
-    stats->secondary_steps = sh.sum.secondary_steps;
-    stats->secondary_ns = sh.sum.secondary_ns;
-    stats->primary_ns = sh.thread_ns - sh.sum.secondary_ns;
-    stats->file_changed = atomic_load(&sh.changed);
+    exact_workers_free(&sy, job);
+    pthread_mutex_destroy(&sy.lock);
+    stats->rays = (uint64_t)npx + sy.sum.rays;
+    stats->hits = sy.sum.hits;
+    stats->steps = sy.sum.steps;
+    stats->aa_pixels = sy.sum.aa_pixels;
+    stats->aa_full = sy.sum.aa_full;
+    stats->shadow_rays = sy.sum.shadow_rays;
+    stats->ao_rays = sy.sum.ao_rays;
+    stats->secondary_steps = sy.sum.secondary_steps;
+    stats->secondary_ns = sy.sum.secondary_ns;
+    stats->primary_ns = sy.thread_ns - sy.sum.secondary_ns;
+    stats->file_changed = atomic_load(&sy.changed);
     return rc ? rc : rc1;
 }

@@ -10,6 +10,7 @@
 #include "common/view/camera.h"
 #include "format/oct.h"
 #include "render/aa.h"
+#include "render/exact_scene.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/trace_impl.h"
@@ -20,7 +21,8 @@
 typedef struct frame_job {
     const oct_tree *tree;
     const camera *cam;
-    trace_opts opts;
+    trace_opts opts;    /* opts.exact is set per thread from `exact` */
+    const exact_scene *exact; /* not NULL: --exact */
     shade_params shade;
     uint8_t *rgb;       /* width*height*3 sRGB bytes, rows top to bottom; required */
     float *depth;       /* width*height t values (+inf on miss), or NULL */
@@ -54,7 +56,8 @@ typedef struct frame_stats {
 } frame_stats;
 
 /* Returns 0, or an errno value when a thread could not be started (the
- * frame is then rendered by the threads that did start). */
+ * frame is then rendered by the threads that did start); -1 before
+ * rendering anything when --exact's per-thread scratch cannot be had. */
 int frame_render(const frame_job *job, frame_stats *stats);
 
 /* image_srgb8(x), bit for bit, by tables of buckets and thresholds (no

@@ -19,6 +19,7 @@
 #include "format/oct.h"
 #include "render/aa.h"
 #include "render/ao.h"
+#include "render/exact_load.h"
 #include "render/frame.h"
 #include "render/framing.h"
 #include "render/map_guard.h"
@@ -32,7 +33,7 @@ _Static_assert(VIEWS_AA_MAX == AA_MAX && VIEWS_AO_MAX == AO_MAX_RAYS, "views lim
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
-    "              [--split K] [--refine] [--light X,Y,Z] [--background R,G,B]\n"
+    "              [--split K] [--refine] [--exact] [--light X,Y,Z] [--background R,G,B]\n"
     "              [--aa N] [--alpha] [--shadows] [--ao N]\n"
     "              [--beam N] [--threads N] [--trust] [--info] [-q] [-v]\n"
     "       render FILE.oct --views VIEWS_FILE [--part I/N] [options]\n"
@@ -52,6 +53,9 @@ static const char help_text[] =
     "                      a name ending in .pfm gets float normals (3-channel PFM)\n"
     "  --split K           octree depth where the empty-space skipping stops (default: levels)\n"
     "  --refine            intersect the voxels' stored planes for sub-voxel depth\n"
+    "  --exact             place each hit at the first root of the file's stored\n"
+    "                      functions in the occupied voxels the ray crosses: exact\n"
+    "                      depth, normals (the gradient) and colour (format 1.1)\n"
     "  --beam N            walk N x N pixel blocks (and their 4 x 4 sub-blocks) as\n"
     "                      pyramids first, to skip what no ray of them can hit\n"
     "                      (default 32; 0: off; same image)\n"
@@ -440,13 +444,14 @@ static void report_view(const render_args *o, const views_view *v, const frame_s
 /* Renders one view and writes its images; adds its time and rays to the
  * totals. Returns EXIT_OK or EXIT_RUNTIME. */
 static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
-                       const camera *cam, const render_buffers *buf, double *total_ms,
-                       uint64_t *total_rays)
+                       const camera *cam, const render_buffers *buf, const exact_scene *es,
+                       double *total_ms, uint64_t *total_rays)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
     job.tree = tree;
     job.cam = cam;
+    job.exact = v->exact ? es : NULL;
     job.opts.split = o->split < 0 ? tree->levels : (unsigned)o->split;
     job.opts.refine = o->refine;
     job.shade.ambient = 0.15f;
@@ -472,6 +477,10 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     frame_stats st;
     double t0 = now_ms();
     const int rc = frame_render(&job, &st);
+    if (rc < 0) {
+        diag_error("out of memory for --exact's scratch");
+        return EXIT_RUNTIME;
+    }
     if (rc != 0) /* fewer threads, or (out of memory for --aa) one ray a pixel */
         fprintf(stderr, "render: %s: %s: rendered with what could be had\n", v->out, strerror(rc));
     double ms = now_ms() - t0;
@@ -506,7 +515,8 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
 /* The view loop: every view in turn (with --part I/N, views I, I+N, ...),
  * then the totals line. */
 static int render_views(const oct_tree *tree, const render_args *o, const views_view *list,
-                        size_t nviews, const camera *cams, const render_buffers *buf)
+                        size_t nviews, const camera *cams, const render_buffers *buf,
+                        const exact_scene *es)
 {
     double total_ms = 0.0;
     uint64_t total_rays = 0;
@@ -518,7 +528,7 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
             diag_path_error(o->oct_path, "changed while being read");
             return EXIT_RUNTIME;
         }
-        int st = render_view(tree, o, &list[k], &cams[k], buf, &total_ms, &total_rays);
+        int st = render_view(tree, o, &list[k], &cams[k], buf, es, &total_ms, &total_rays);
         if (st != EXIT_OK)
             return st;
     }
@@ -548,6 +558,8 @@ int main(int argc, char **argv)
     render_buffers buf = {NULL, NULL, NULL, NULL, NULL};
     camera *cams = NULL;
     oct_file *file = NULL;
+    exact_loaded exact;
+    memset(&exact, 0, sizeof exact);
 
     if (o.views_path)
         status = load_views_file(&o, &o.base, &views_text, &list, &nviews);
@@ -555,8 +567,20 @@ int main(int argc, char **argv)
         status = open_tree(&o, &file);
     if (status != EXIT_OK || (!o.views_path && !o.base.out))
         goto done; /* an error, or --info only */
-    if (oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) { /* only the function can place hits */
+    int any_exact = o.base.exact, all_exact = nviews ? 1 : o.base.exact;
+    for (size_t k = 0; k < nviews; k++) {
+        any_exact |= list[k].exact;
+        all_exact &= list[k].exact;
+    }
+    if ((oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) && !all_exact) {
+        /* only the function can place hits */
         diag_path_error(o.oct_path, "stores no normals (rasterized with --shell-only): use --exact");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
+    const char *why = NULL;
+    if (any_exact && exact_load(file, &exact, &why) != 0) {
+        diag_path_error(o.oct_path, "%s", why);
         status = EXIT_RUNTIME;
         goto done;
     }
@@ -586,10 +610,11 @@ int main(int argc, char **argv)
         status = EXIT_RUNTIME;
         goto done;
     }
-    status = render_views(tree, &o, list, nviews, cams, &buf);
+    status = render_views(tree, &o, list, nviews, cams, &buf, any_exact ? &exact.es : NULL);
 
 done:
     map_guard_close();
+    exact_loaded_free(&exact);
     free(buf.rgb);
     free(buf.depth);
     free(buf.nrm);

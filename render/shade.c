@@ -38,14 +38,27 @@ double shade_normal(const oct_tree *tree, const shade_params *p, const trace_hit
         n[0] = n[1] = n[2] = 0.0f;
         return 0.0;
     }
-    uint32_t rec = tree->voxels[hit->voxel];
-    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
-    double facing = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
-    if (facing > 0.0) /* two-sided: face the viewer */
+    if (hit->exact) { /* the gradient, already facing the viewer */
         for (int a = 0; a < 3; a++)
-            n[a] = -n[a];
+            n[a] = (float)hit->normal[a];
+    } else {
+        uint32_t rec = tree->voxels[hit->voxel];
+        oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
+        double facing = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+        if (facing > 0.0) /* two-sided: face the viewer */
+            for (int a = 0; a < 3; a++)
+                n[a] = -n[a];
+    }
     double lam = n[0] * p->light[0] + n[1] * p->light[1] + n[2] * p->light[2];
     return lam < 0.0 ? 0.0 : lam;
+}
+
+unsigned shade_surface(const oct_tree *tree, const trace_hit *hit)
+{
+    if (!hit->hit)
+        return 0;
+    unsigned s = hit->exact ? hit->surface : tree->surfaces ? tree->surfaces[hit->voxel] : 0;
+    return s < tree->surface_count ? s : 0;
 }
 
 void shade_color(const oct_tree *tree, const shade_params *p, const trace_hit *hit, double lam,
@@ -56,10 +69,7 @@ void shade_color(const oct_tree *tree, const shade_params *p, const trace_hit *h
             rgb[a] = p->background[a];
         return;
     }
-    unsigned s = tree->surfaces ? tree->surfaces[hit->voxel] : 0;
-    if (s >= tree->surface_count)
-        s = 0;
-    const float *col = tree->palette + 3 * s;
+    const float *col = tree->palette + 3 * shade_surface(tree, hit);
     float k = p->ambient * ao + (1.0f - p->ambient) * (float)lam;
     for (int a = 0; a < 3; a++)
         rgb[a] = col[a] * k;

@@ -30,6 +30,10 @@ int shade_set_light(shade_params *p, const double light[3]);
 double shade_normal(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
                     const double dir[3], float n[3]);
 
+/* The palette index of a hit's surface: the root's with --exact, else the
+ * voxel's; 0 for a miss. */
+unsigned shade_surface(const oct_tree *tree, const trace_hit *hit);
+
 /* Linear RGB of a hit with Lambert term `lam` (shade_normal's, times the
  * light's visibility) and ambient visibility `ao` (1: open), in rgb[3];
  * the background on a miss. */

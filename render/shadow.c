@@ -24,18 +24,16 @@ static int voxel_occupied(const oct_tree *tree, const double g[3])
     return (int)(an.node[an.depth].mask >> c & 1u);
 }
 
-int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])
+/* The start point from base (grid units, on the surface) along n, moved
+ * on out of occupied voxels (shadow_origin). */
+static int origin_from(const oct_tree *tree, const double base[3], const float n[3], double o[3])
 {
-    const uint32_t rec = tree->voxels[hit->voxel];
-    float ns[3]; /* the stored normal: the plane's, n or -n */
-    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, ns);
-    const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
     const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double g[3];
     for (unsigned k = 0; k < SHADOW_TRIES; k++) {
         const double h = shadow_offset(n) + (double)k;
         for (int a = 0; a < 3; a++)
-            g[a] = (double)hit->xyz[a] + 0.5 + off * (double)ns[a] + h * (double)n[a];
+            g[a] = base[a] + h * (double)n[a];
         if (!voxel_occupied(tree, g)) {
             for (int a = 0; a < 3; a++)
                 o[a] = tree->origin[a] + g[a] * vox;
@@ -43,6 +41,27 @@ int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], 
         }
     }
     return 0;
+}
+
+int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])
+{
+    const uint32_t rec = tree->voxels[hit->voxel];
+    float ns[3]; /* the stored normal: the plane's, n or -n */
+    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, ns);
+    const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
+    double base[3];
+    for (int a = 0; a < 3; a++)
+        base[a] = (double)hit->xyz[a] + 0.5 + off * (double)ns[a];
+    return origin_from(tree, base, n, o);
+}
+
+int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], double o[3])
+{
+    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
+    double base[3];
+    for (int a = 0; a < 3; a++)
+        base[a] = (p[a] - tree->origin[a]) / vox;
+    return origin_from(tree, base, n, o);
 }
 
 int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,

@@ -45,6 +45,10 @@ double shadow_offset(const float n[3]);
  * open: a start inside the surface would shadow it by itself). */
 int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3]);
 
+/* The same from a surface point p in world coordinates (an --exact hit,
+ * whose place is known without the voxel's stored plane). */
+int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], double o[3]);
+
 /* 1 when the ray o + t d (d unit), 0 <= t <= t_max (+inf allowed), meets an
  * occupied voxel (by opts' rule), traced by `traverse` (NULL: the build's
  * preferred implementation); 0 otherwise. Adds its DDA steps to *steps. */

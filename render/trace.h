@@ -107,18 +107,27 @@ int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r);
  * Returns 0 when nothing of the ray is left (then it must not be traced). */
 int trace_clip(trace_ray *r, double t_lo, double t_hi);
 
+struct exact_worker; /* render/exact_scene.h */
+
 typedef struct trace_opts {
     unsigned split;   /* K: empty cells of depth <= K are skipped whole; 0..L */
     int refine;       /* hit where the ray crosses the stored planes of a run of
                          occupied voxels (RENDER.md, "--refine"); 0: voxel entry */
+    struct exact_worker *exact; /* not NULL: --exact, the first root of the scene's
+                                   functions in the occupied voxels (RENDER.md,
+                                   "--exact"); this thread's own; refine is ignored */
 } trace_opts;
 
 typedef struct trace_hit {
     int hit;          /* 1 hit, 0 miss */
     uint64_t voxel;   /* index into tree->voxels / surfaces */
     uint32_t xyz[3];  /* integer voxel coordinates */
-    double t;         /* caller's t of the hit: voxel entry, or plane with refine */
+    double t;         /* caller's t of the hit: voxel entry, plane with refine, root
+                         with exact */
     uint32_t steps;   /* DDA steps taken (<= trace_max_steps) */
+    int exact;        /* 1: an --exact hit, with the two fields below */
+    uint32_t surface; /* the palette index of the surface whose root it is */
+    double normal[3]; /* its unit gradient there, facing the viewer */
 } trace_hit;
 
 /* Upper bound on steps for a tree of `levels` levels: 3 * 2^L + L. */

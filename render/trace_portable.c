@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "render/exact_scene.h"
 #include "render/trace_impl.h"
 
 /* The traversal's state: the plane-time parameters, the current cell (depth
@@ -131,6 +132,7 @@ int trace_traverse_portable(const oct_tree *tree, const trace_opts *opts, const 
     hit->hit = 0;
     hit->t = INFINITY;
     hit->steps = 0;
+    hit->exact = 0;
     if (tree->node_count[0] == 0)
         return 0;
     const unsigned split = opts->split > levels ? levels : opts->split;
@@ -176,7 +178,11 @@ int trace_traverse_portable(const oct_tree *tree, const trace_opts *opts, const 
             if (w.d == levels) {
                 /* a voxel */
                 double t_hit = tc;
-                if (!opts->refine) {
+                if (opts->exact) {
+                    const double te = min3(w.t);
+                    hit->hit = exact_voxel(opts->exact, r, w.v, tc, te < t_end ? te : t_end,
+                                           &t_hit, hit);
+                } else if (!opts->refine) {
                     hit->hit = 1;
                 } else {
                     const double te = min3(w.t);

@@ -1,5 +1,6 @@
 /* trace_sse: the traversal (trace_impl.h) with the three axes in SSE
  * registers, built when the target has SSE4.1 (the default x86-64-v2). */
+#include "render/exact_scene.h"
 #include "render/trace_impl.h"
 
 #if TRACE_HAVE_SSE
@@ -144,18 +145,21 @@ voxel_walk(const sse_axes *ax, __m128i V, uint32_t size, __m128d TC, __m128d Wxy
 }
 
 /* A voxel (node index n) entered at tc, with exit times Txy, Tzw: the hit,
- * or with --refine the plane test of the current run (*side). Returns 1 and
- * fills hit on a hit. */
-SSE_INLINE int voxel_hit(const oct_tree *tree, const trace_ray *r, int refine, uint64_t n,
-                         double tc, __m128d Txy, __m128d Tzw, __m128i V, int *side, trace_hit *hit)
+ * with --refine the plane test of the current run (*side), with --exact the
+ * root test. Returns 1 and fills hit on a hit. */
+SSE_INLINE int voxel_hit(const oct_tree *tree, const trace_ray *r, const trace_opts *opts,
+                         uint64_t n, double tc, __m128d Txy, __m128d Tzw, __m128i V, int *side,
+                         trace_hit *hit)
 {
     double t = tc;
-    if (refine) {
+    if (opts->refine || opts->exact) {
         const __m128d m2 = _mm_min_pd(Txy, Tzw);
         const double te = _mm_cvtsd_f64(_mm_min_sd(m2, _mm_unpackhi_pd(m2, m2)));
+        const double t_out = te < r->t_end ? te : r->t_end;
         uint32_t v[4];
         _mm_storeu_si128((__m128i *)v, V);
-        if (!trace_refine_voxel(tree, r, n, v, tc, te < r->t_end ? te : r->t_end, side, &t))
+        if (opts->exact ? !exact_voxel(opts->exact, r, v, tc, t_out, &t, hit)
+                        : !trace_refine_voxel(tree, r, n, v, tc, t_out, side, &t))
             return 0;
     }
     hit->hit = 1;
@@ -207,10 +211,10 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
     hit->hit = 0;
     hit->t = INFINITY;
     hit->steps = 0;
+    hit->exact = 0;
     if (tree->node_count[0] == 0)
         return 0;
     const unsigned split = opts->split > levels ? levels : opts->split;
-    const int refine = opts->refine;
     const uint32_t max_steps = trace_max_steps(levels);
     const double t_end = r->t_end;
     const oct_group *const *groups = tree->groups;
@@ -255,7 +259,7 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
         if (M >> ci & 1u) {
             const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
             if (d == levels) {
-                if (voxel_hit(tree, r, refine, n, tc, Txy, Tzw, V, &side, hit))
+                if (voxel_hit(tree, r, opts, n, tc, Txy, Tzw, V, &side, hit))
                     break;
                 goto step;
             }

@@ -40,6 +40,8 @@ int views_flag(views_view *v, const char *name)
         f = v ? &v->alpha : &dummy;
     else if (strcmp(name, "--shadows") == 0)
         f = v ? &v->shadows : &dummy;
+    else if (strcmp(name, "--exact") == 0)
+        f = v ? &v->exact : &dummy;
     if (!f)
         return 0;
     *f = 1;

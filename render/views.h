@@ -5,7 +5,7 @@
  * skipped. A line is whitespace-separated options with the same names and
  * value syntax as the command line:
  *     -o OUT.png [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z] [--fov DEG]
- *     [--size WxH] [--depth OUT.pfm] [--normals OUT.png]
+ *     [--size WxH] [--depth OUT.pfm] [--normals OUT.png] [--exact]
  *     [--aa N] [--ao N] [--alpha] [--shadows]
  * Options a line leaves out take the command line's values (or the
  * defaults). Paths cannot contain whitespace or '#'. Every line needs -o.
@@ -26,6 +26,7 @@ typedef struct views_view {
     long aa;             /* 1..VIEWS_AA_MAX samples a side where needed */
     long ao;             /* ambient occlusion rays, 0..VIEWS_AO_MAX */
     int alpha, shadows;  /* flags */
+    int exact;           /* --exact: hits placed by the stored functions */
     unsigned line;       /* views-file line (1-based), 0 for the command line */
 } views_view;
 
@@ -39,7 +40,7 @@ void views_defaults(views_view *v);
 /* 1 when `name` is a per-view option that takes a value. */
 int views_is_option(const char *name);
 
-/* 1 when `name` is a per-view flag (no value): --alpha, --shadows; sets it
+/* 1 when `name` is a per-view flag (no value): --alpha, --shadows, --exact; sets it
  * in v when v is not NULL. */
 int views_flag(views_view *v, const char *name);
 

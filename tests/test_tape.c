@@ -108,6 +108,54 @@ static double f_manyblobs(const double *p, int s)
     return v - 0.5;
 }
 
+/* the scenes render --exact is checked on */
+static double f_crease(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2];
+    double box = mx(mx(fabs(x) - 0.7, fabs(y) - 0.5), fabs(z) - 0.45);
+    double cut = mx(mx(sq(x) + sq(z + 0.3) - 1, 0.04 - sq(y) - sq(z)), 0.55 - fabs(x + y) - 0.3 * z);
+    return mn(mx(box, cut), r2(x, y, z, 0.45, 0.25, 0.45) - 0.04);
+}
+static double f_gyroid_ball(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2];
+    double g = sin(20 * x) * cos(20 * y) + sin(20 * y) * cos(20 * z) + sin(20 * z) * cos(20 * x);
+    return mx(fabs(g) - 0.2, sq(x) + sq(y) + sq(z) - 0.81);
+}
+static double f_plate(const double *p, int s)
+{
+    (void)s;
+    return mx(fabs(0.3 * p[0] + 0.2 * p[1] + p[2] - 0.0123) - 0.0004, sq(p[0]) + sq(p[1]) - 0.6);
+}
+static double f_cube(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2];
+    return mx(mx(fabs(0.8 * x + 0.6 * y), fabs(0.8 * y - 0.6 * x)), fabs(z + 0.05)) - 0.6;
+}
+static double f_heart(const double *p, int s)
+{
+    (void)s;
+    double x = p[0], y = p[1], z = p[2], z3 = z * z * z;
+    return pow(sq(x) + 2.25 * sq(y) + sq(z) - 1, 3) - sq(x) * z3 - 0.1125 * sq(y) * z3;
+}
+/* the generator of scenes/blobs64.scene: a jittered 4x4x4 lattice */
+static double f_blobs64(const double *p, int s)
+{
+    (void)s;
+    double v = 0;
+    for (int n = 0; n < 64; n++) {
+        double c[3];
+        const int idx[3] = {n / 16, n / 4 % 4, n % 4}, mul[3] = {7, 11, 13};
+        for (int a = 0; a < 3; a++)
+            c[a] = round((0.2 + 0.2 * idx[a] + 0.001 * (mul[a] * n % 37)) * 1000) / 1000;
+        v += exp(-90 * r2(p[0], p[1], p[2], c[0], c[1], c[2]));
+    }
+    return v - 0.4;
+}
+
 static const struct {
     const char *path;
     double (*f)(const double *p, int surface);
@@ -118,6 +166,9 @@ static const struct {
     {"scenes/csg.scene", f_csg, 1},         {"scenes/gyroid.scene", f_gyroid, 1},
     {"scenes/barth.scene", f_barth, 1},     {"scenes/thin.scene", f_thin, 2},
     {"scenes/multi.scene", f_multi, 3},     {"scenes/manyblobs.scene", f_manyblobs, 1},
+    {"scenes/crease.scene", f_crease, 1},   {"scenes/gyroid_ball.scene", f_gyroid_ball, 1},
+    {"scenes/plate.scene", f_plate, 1},     {"scenes/cube.scene", f_cube, 1},
+    {"scenes/heart.scene", f_heart, 1},     {"scenes/blobs64.scene", f_blobs64, 1},
 };
 #define NSCENES (sizeof scenes / sizeof scenes[0])
 

@@ -146,7 +146,7 @@ static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, 
     for (unsigned k = k_min; k <= tree->levels; k++) {
         for (int refine = 0; refine <= 1; refine++) {
             if (refine) {
-                trace_opts ro = {k, 1};
+                trace_opts ro = {k, 1, NULL};
                 trace_hit rh;
                 trace_cast_all(tree, &ro, eye, dir, &rh);
                 st->traces++;
@@ -158,7 +158,7 @@ static void check_ray(const oct_tree *tree, const uint32_t (*vox)[3], size_t n, 
                 }
                 continue;
             }
-            trace_opts opts = {k, refine};
+            trace_opts opts = {k, refine, NULL};
             trace_hit h;
             trace_cast_all(tree, &opts, eye, dir, &h);
             st->traces++;
@@ -330,7 +330,7 @@ static void test_empty_tree_and_degenerate_rays(void **state)
     (void)state;
     oct_tree *t = tree_util_simple(4, NULL, 0);
     assert_non_null(t);
-    trace_opts o = {2, 0};
+    trace_opts o = {2, 0, NULL};
     trace_hit h;
     const double eye[3] = {0.5, 0.5, -1}, dir[3] = {0, 0, 1};
     assert_int_equal(trace_cast_all(t, &o, eye, dir, &h), 0);
@@ -432,7 +432,7 @@ static void test_clip_same_hit(void **state)
             trace_ray r0;
             if (!trace_setup(t, eye, dir, &r0))
                 continue;
-            trace_opts plain = {L, 0};
+            trace_opts plain = {L, 0, NULL};
             trace_hit hp;
             if (!trace_prepared_all(t, &plain, &r0, &hp))
                 continue;
@@ -447,7 +447,7 @@ static void test_clip_same_hit(void **state)
             starts[ns++] = hp.t;
             for (unsigned K = 0; K <= L; K++)
                 for (int refine = 0; refine <= 1; refine++) {
-                    const trace_opts op = {K, refine};
+                    const trace_opts op = {K, refine, NULL};
                     trace_hit h0;
                     trace_prepared_all(t, &op, &r0, &h0);
                     for (int c = 0; c < ns; c++) {
@@ -521,7 +521,7 @@ static void test_anchored_same_hit(void **state)
              * shortly before it (deep in occupied cells) */
             double t_start;
             const int a0 = (int)irand(3);
-            const trace_opts whole = {L, 0};
+            const trace_opts whole = {L, 0, NULL};
             trace_hit hw;
             const int how = (int)irand(4);
             if (how == 0 && (r0.active >> a0 & 1)) {
@@ -567,7 +567,7 @@ static void test_anchored_same_hit(void **state)
             deepest = an.depth > deepest ? an.depth : deepest;
             for (int k = 0; k < nr; k++)
                 for (int refine = 0; refine <= 1; refine++) {
-                    const trace_opts op = {irand(2) ? L : irand(L + 1), refine};
+                    const trace_opts op = {irand(2) ? L : irand(L + 1), refine, NULL};
                     trace_hit h0, h1;
                     trace_prepared_all(t, &op, &rays[k], &h0);
                     trace_anchored_all(t, &op, &rays[k], &an, &h1);

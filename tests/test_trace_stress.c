@@ -271,7 +271,7 @@ static void check_exact(const oct_tree *t, const uint32_t (*vox)[3], size_t n, c
     st->rays++;
     st->hits += want >= 0;
     for (unsigned k = k_lo; k <= k_hi; k++) {
-        trace_opts opts = {k, 0};
+        trace_opts opts = {k, 0, NULL};
         trace_hit h;
         trace_cast_all(t, &opts, eye, dir, &h);
         st->traces++;
@@ -485,7 +485,7 @@ static void test_general_rays_tolerance(void **state)
             const int aimed = ri % 3 == 0 && ri % 7 != 0;
             const unsigned k0 = levels > 8 ? levels - 9 : 0, kstep = levels > 8 ? 3 : 1;
             for (unsigned k = k0; k <= levels; k += kstep) {
-                trace_opts opts = {k, 0};
+                trace_opts opts = {k, 0, NULL};
                 trace_hit h;
                 trace_cast_all(t, &opts, eye, dir, &h);
                 st.traces++;

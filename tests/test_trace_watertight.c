@@ -117,7 +117,7 @@ static void shoot_at_shell(const oct_tree *t, const uint32_t (*v)[3], size_t n, 
             back[a] = -dir[a];
         }
         for (unsigned k = 0; k <= t->levels; k++) {
-            trace_opts o = {k, 0};
+            trace_opts o = {k, 0, NULL};
             trace_hit hin, hout;
             trace_cast_all(t, &o, eye, dir, &hin);
             trace_cast_all(t, &o, far, back, &hout);
@@ -196,7 +196,7 @@ static void test_step_bound(void **state)
         assert_non_null(t);
         /* d = (1, 1 - e, 1 - 2e): crosses each axis' planes at distinct times */
         const double eye[3] = {0, 0, 0}, dir[3] = {1, 1 - 0x1p-30, 1 - 0x1p-29};
-        trace_opts o = {0, 0};
+        trace_opts o = {0, 0, NULL};
         trace_hit h;
         assert_int_equal(trace_cast_all(t, &o, eye, dir, &h), 1);
         assert_true(h.steps <= trace_max_steps(levels));

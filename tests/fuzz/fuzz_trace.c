@@ -95,7 +95,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     for (unsigned k = 0; k <= levels; k++) {
-        trace_opts opts = {k, 0};
+        trace_opts opts = {k, 0, NULL};
         trace_hit h;
         trace_cast_all(t, &opts, o, d, &h); /* unit cells: world = grid */
         int good = h.steps <= trace_max_steps(levels);

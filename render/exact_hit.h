@@ -1,0 +1,72 @@
+/* exact_hit: the first root of a surface function along a ray segment, by
+ * interval arithmetic (common/expr/interval.h, outward rounding) and a
+ * bracketed refinement to full double precision: what `render --exact`
+ * runs in every occupied voxel a ray crosses (RENDER.md, "--exact"). */
+#ifndef EXACT_HIT_H
+#define EXACT_HIT_H
+
+#include <stdint.h>
+
+#include "common/expr/tape.h"
+
+/* A line p(t) = o + t * d in the tape's (world) coordinates. */
+typedef struct exact_line {
+    double o[3], d[3];
+} exact_line;
+
+/* Caller scratch for tapes of up to n instructions. */
+typedef struct exact_scratch {
+    uint32_t n;
+    double *slots;
+    interval *islots;
+    tape_idual *gslots;
+    tape_dual *dslots;
+} exact_scratch;
+
+/* Allocates scratch for tapes of up to n instructions: 0, or -1 when out
+ * of memory (then nothing is held). */
+int exact_scratch_init(exact_scratch *w, uint32_t n);
+void exact_scratch_free(exact_scratch *w); /* accepts a zeroed or freed one */
+
+/* Segments no wider than this share of max(1, |t|) are the resolution
+ * limit: the finder decides there (see exact_first_root). */
+#define EXACT_REL_RES 0x1p-40
+
+/* What a search found besides the root. */
+enum {
+    EXACT_ROOT = 1,  /* a sign change of f, converged to adjacent doubles */
+    EXACT_TOUCH = 2, /* f reaches 0 (within the evaluator's enclosure) without a
+                        sign change at the resolution limit: a tangential touch */
+};
+
+/* The first root of g(t) = f(o + t d) for t in [a, b] (a <= b, both finite),
+ * or +inf when there is none; *kind (may be NULL) receives EXACT_ROOT or
+ * EXACT_TOUCH on a hit. `cull` (NULL: t) is the tape whose interval drops
+ * segments: t or one whose interval evaluation encloses t's on the boxes
+ * tested (a tape_prune_const of t for a box holding them, however coarse its
+ * `tiny`); the derivative and every point value come from t.
+ *
+ * Front-to-back bisection: a segment is dropped when the interval of f over
+ * the box its points span (outward-rounded hull of its ends) excludes 0 or
+ * is NaN (that interval encloses f wherever f is defined, flagged or not;
+ * NaN: defined nowhere); a
+ * segment on which the interval of g' = grad f . d excludes 0 is monotone
+ * and holds a root exactly when g changes sign between its ends, which is
+ * then refined (Illinois regula falsi with bisection steps) until no double
+ * lies between the bracket's ends; the end where |g| is smaller is the
+ * root. Other segments are halved. At the resolution limit (width <=
+ * EXACT_REL_RES * max(1, |t|), or 60 halvings) a segment that still cannot be
+ * dropped is a root if g changes sign over it (refined as above; a sign
+ * change through a pole, where |g| grows as the bracket closes, is none), a
+ * touch at its midpoint if g is finite at both ends, and nothing when g is
+ * undefined (NaN) or infinite at an end: where f is undefined there is no
+ * surface (docs/evaluation.md), and a pole is none either. */
+double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const exact_line *ray,
+                        double a, double b, int *kind);
+
+/* The unit normal at p: grad f(p) normalised, turned to face against d;
+ * -d/|d| where the gradient is zero or not finite. */
+void exact_normal(const tape *t, exact_scratch *w, const double p[3], const double d[3],
+                  double n[3]);
+
+#endif

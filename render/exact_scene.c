@@ -1,0 +1,283 @@
+/* exact_scene: per coarse cell the surfaces present and their pruned
+ * tapes; the exact hit test of one voxel (see exact_scene.h). */
+#include "render/exact_scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Growable pools while building; pointers are set once they stop moving. */
+typedef struct builder {
+    exact_scene *es;
+    const tape *tapes;
+    uint32_t nsurf;
+    uint32_t cap_cells, cap_cand;
+    size_t n_insn, cap_insn, n_konst, cap_konst;
+    struct {
+        uint64_t exact[2], cull[2]; /* insn, konst pool offsets; UINT64_MAX: the whole tape */
+    } *off;                         /* per candidate */
+    interval *slots;
+    tape_insn *tmp_insn;
+    tape_const *tmp_konst;
+    uint32_t *tmp_scratch;
+} builder;
+
+static int grow(void **p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return 0;
+    size_t c = *cap ? *cap : 64;
+    while (c < need)
+        c *= 2;
+    void *q = realloc(*p, c * size);
+    if (!q)
+        return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+/* The world box of coarse cell c (cells of `size` voxels), grown by 2^-8
+ * voxel each side (more than the 2^-16 voxel a test span is widened by) and
+ * rounded outward, so every span tested in it lies inside. */
+static void cell_box(const exact_scene *es, const uint32_t c[3], uint32_t size, interval box[3])
+{
+    const double m = 0x1p-8;
+    for (int a = 0; a < 3; a++) {
+        const double lo = es->tree->origin[a] + ((double)c[a] * size - m) * es->h;
+        const double hi = es->tree->origin[a] + ((double)(c[a] + 1) * size + m) * es->h;
+        box[a].lo = interval_next_down(interval_next_down(lo));
+        box[a].hi = interval_next_up(interval_next_up(hi));
+    }
+}
+
+/* t pruned with `tiny` for the box whose slot intervals b->slots holds,
+ * appended to the pools (*off: its offsets, fixed up once they stop
+ * moving), or t itself (off UINT64_MAX) when pruning saves not a quarter. */
+static int store_pruned(builder *b, const tape *t, unsigned flags, double tiny, tape *out,
+                        uint64_t off[2], uint64_t *insns)
+{
+    exact_scene *es = b->es;
+    tape p;
+    tape_prune_const(t, b->slots, flags, isfinite(tiny) ? tiny : -1.0, b->tmp_insn, b->tmp_konst,
+                     b->tmp_scratch, &p);
+    if ((uint64_t)p.n * 4 > (uint64_t)t->n * 3) {
+        *out = *t;
+        out->owned = 0;
+        off[0] = off[1] = UINT64_MAX;
+        *insns += t->n;
+        return 0;
+    }
+    if (grow((void **)&es->insn_pool, &b->cap_insn, b->n_insn + p.n, sizeof(tape_insn)) ||
+        grow((void **)&es->konst_pool, &b->cap_konst, b->n_konst + p.nconst, sizeof(tape_const)))
+        return -1;
+    memcpy(es->insn_pool + b->n_insn, p.insn, p.n * sizeof(tape_insn));
+    memcpy(es->konst_pool + b->n_konst, p.konst, p.nconst * sizeof(tape_const));
+    *out = p;
+    out->owned = 0;
+    off[0] = b->n_insn;
+    off[1] = b->n_konst;
+    b->n_insn += p.n;
+    b->n_konst += p.nconst;
+    *insns += p.n;
+    return 0;
+}
+
+/* Registers coarse cell c: every surface whose enclosure over the cell
+ * may hold 0 becomes a candidate with two tapes pruned for the cell. The
+ * exact one turns into constants only terms narrower there than 2^-30 of
+ * f's spread over one voxel (their midpoint for the point evaluator: a root
+ * moves by about 2^-30 of a voxel at most, far below the targets); the
+ * culling one, whose interval alone is used (to drop segments: sound for
+ * any tiny, tape.h), takes the rasterizer's 10^-3, so a far blob costs
+ * nothing there. */
+static int add_cell(builder *b, const uint32_t c[3])
+{
+    exact_scene *es = b->es;
+    const unsigned D = es->depth, L = es->tree->levels;
+    const uint32_t size = UINT32_C(1) << (L - D);
+    size_t cap = b->cap_cells;
+    if (grow((void **)&es->first, &cap, (size_t)es->ncells + 2, sizeof *es->first))
+        return -1;
+    b->cap_cells = (uint32_t)cap;
+    interval box[3];
+    cell_box(es, c, size, box);
+    es->first[es->ncells] = es->ncand;
+    for (uint32_t s = 0; s < b->nsurf; s++) {
+        const tape *t = &b->tapes[s];
+        unsigned flags = 0;
+        const interval F = tape_eval_interval(t, box, b->slots, &flags);
+        if (interval_is_nan(F) || F.lo > 0.0 || F.hi < 0.0)
+            continue; /* not here (exact_first_root's rule) */
+        size_t cc = b->cap_cand;
+        if (grow((void **)&es->cand, &cc, (size_t)es->ncand + 1, sizeof *es->cand))
+            return -1;
+        size_t co = b->cap_cand;
+        if (grow((void **)&b->off, &co, (size_t)es->ncand + 1, sizeof *b->off))
+            return -1;
+        b->cap_cand = (uint32_t)(cc < co ? cc : co);
+        exact_cand *k = &es->cand[es->ncand];
+        k->surface = s;
+        const double per_voxel = ldexp(F.hi - F.lo, -(int)(L - D));
+        es->whole_insns += t->n;
+        if (store_pruned(b, t, flags, ldexp(per_voxel, -30), &k->t, b->off[es->ncand].exact,
+                         &es->pruned_insns) ||
+            store_pruned(b, t, flags, 1e-3 * per_voxel, &k->cull, b->off[es->ncand].cull,
+                         &es->cull_insns))
+            return -1;
+        es->ncand++;
+    }
+    const uint32_t dim = UINT32_C(1) << D;
+    es->cell_slot[((size_t)c[2] * dim + c[1]) * dim + c[0]] = es->ncells;
+    es->ncells++;
+    es->first[es->ncells] = es->ncand;
+    return 0;
+}
+
+/* The tree's cells of depth D below node n of depth d (corner c in cells
+ * of depth d), in storage order. Depth <= 20: the recursion is shallow. */
+static int visit(builder *b, unsigned d, uint64_t n, const uint32_t c[3])
+{
+    const exact_scene *es = b->es;
+    if (d == es->depth)
+        return add_cell(b, c);
+    const oct_children ch = oct_node_children(es->tree->groups[d], n);
+    uint64_t k = ch.first;
+    for (unsigned i = 0; i < 8; i++) {
+        if (!(ch.mask >> i & 1u))
+            continue;
+        const uint32_t cc[3] = {2 * c[0] + (i & 1u), 2 * c[1] + (i >> 1 & 1u),
+                                2 * c[2] + (i >> 2 & 1u)};
+        if (visit(b, d + 1, k++, cc))
+            return -1;
+    }
+    return 0;
+}
+
+int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, unsigned depth)
+{
+    memset(es, 0, sizeof *es);
+    es->tree = tree;
+    es->depth = depth > tree->levels ? tree->levels : depth;
+    if (es->depth > EXACT_CELL_MAX_DEPTH)
+        es->depth = EXACT_CELL_MAX_DEPTH;
+    es->h = ldexp(tree->edge, -(int)tree->levels);
+    builder b;
+    memset(&b, 0, sizeof b);
+    b.es = es;
+    b.tapes = tapes;
+    b.nsurf = tree->surface_count;
+    uint32_t nmax = 1, cmax = 1;
+    for (uint32_t s = 0; s < b.nsurf; s++) {
+        if (tapes[s].n > nmax)
+            nmax = tapes[s].n;
+        if (tapes[s].nconst > cmax)
+            cmax = tapes[s].nconst;
+    }
+    es->max_n = nmax;
+    const size_t cells = (size_t)1 << (3 * es->depth);
+    es->cell_slot = malloc(cells * sizeof *es->cell_slot);
+    b.slots = malloc(nmax * sizeof *b.slots);
+    b.tmp_insn = malloc(nmax * sizeof *b.tmp_insn);
+    b.tmp_konst = malloc(((size_t)cmax + nmax) * sizeof *b.tmp_konst);
+    b.tmp_scratch = malloc(nmax * sizeof *b.tmp_scratch);
+    int rc = -1;
+    if (es->cell_slot && b.slots && b.tmp_insn && b.tmp_konst && b.tmp_scratch) {
+        memset(es->cell_slot, 0xff, cells * sizeof *es->cell_slot);
+        const uint32_t root[3] = {0, 0, 0};
+        rc = tree->node_count[0] ? visit(&b, 0, 0, root) : 0;
+    }
+    if (rc == 0 && !es->first) {
+        es->first = calloc(1, sizeof *es->first);
+        rc = es->first ? 0 : -1;
+    }
+    for (uint32_t k = 0; rc == 0 && k < es->ncand; k++) {
+        if (b.off[k].exact[0] != UINT64_MAX) {
+            es->cand[k].t.insn = es->insn_pool + b.off[k].exact[0];
+            es->cand[k].t.konst = es->konst_pool + b.off[k].exact[1];
+        }
+        if (b.off[k].cull[0] != UINT64_MAX) {
+            es->cand[k].cull.insn = es->insn_pool + b.off[k].cull[0];
+            es->cand[k].cull.konst = es->konst_pool + b.off[k].cull[1];
+        }
+    }
+    free(b.off);
+    free(b.slots);
+    free(b.tmp_insn);
+    free(b.tmp_konst);
+    free(b.tmp_scratch);
+    if (rc != 0)
+        exact_scene_free(es);
+    return rc;
+}
+
+void exact_scene_free(exact_scene *es)
+{
+    free(es->cell_slot);
+    free(es->first);
+    free(es->cand);
+    free(es->insn_pool);
+    free(es->konst_pool);
+    memset(es, 0, sizeof *es);
+}
+
+int exact_worker_init(exact_worker *w, const exact_scene *es)
+{
+    w->scene = es;
+    return exact_scratch_init(&w->scratch, es->max_n);
+}
+
+void exact_worker_free(exact_worker *w)
+{
+    exact_scratch_free(&w->scratch);
+    w->scene = NULL;
+}
+
+int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
+                double t_out, double *t_hit, trace_hit *hit)
+{
+    const exact_scene *es = w->scene;
+    const oct_tree *tree = es->tree;
+    const unsigned shift = tree->levels - es->depth;
+    const uint32_t dim = UINT32_C(1) << es->depth;
+    const uint32_t slot =
+        es->cell_slot[((size_t)(v[2] >> shift) * dim + (v[1] >> shift)) * dim + (v[0] >> shift)];
+    if (slot == UINT32_MAX)
+        return 0; /* (a voxel's cell is always registered) */
+    /* the ray in world units, local t: p(t) = origin + (o + t d) h */
+    exact_line l;
+    double dd = 0.0;
+    for (int a = 0; a < 3; a++) {
+        l.o[a] = tree->origin[a] + r->o[a] * es->h;
+        l.d[a] = r->d[a] * es->h;
+        dd += r->d[a] * r->d[a];
+    }
+    const double widen = 0x1p-16 / sqrt(dd); /* 2^-16 voxel along the ray */
+    double a = t_in - widen, b = t_out + widen;
+    if (a < -r->t_base)
+        a = -r->t_base; /* the caller's t >= 0 */
+    double best = INFINITY;
+    uint32_t best_k = 0;
+    for (uint32_t k = es->first[slot]; k < es->first[slot + 1]; k++) {
+        if (!(a <= b))
+            break;
+        const exact_cand *c = &es->cand[k];
+        const double t = exact_first_root(&c->t, &c->cull, &w->scratch, &l, a, b, NULL);
+        if (t < best) {
+            best = t;
+            best_k = k;
+            b = t; /* a later surface must be nearer to win */
+        }
+    }
+    if (!(best < INFINITY))
+        return 0;
+    const exact_cand *c = &es->cand[best_k];
+    double p[3];
+    for (int k = 0; k < 3; k++)
+        p[k] = l.o[k] + best * l.d[k];
+    exact_normal(&c->t, &w->scratch, p, l.d, hit->normal);
+    hit->exact = 1;
+    hit->surface = c->surface;
+    *t_hit = best;
+    return 1;
+}

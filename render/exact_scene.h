@@ -1,0 +1,69 @@
+/* exact_scene: a tree's surface functions prepared for `render --exact`:
+ * per occupied coarse cell (the tree's nodes of one depth), the surfaces
+ * that can be present there, each with its tape pruned for that cell
+ * (tape_prune_const), so a voxel is never tested with a whole long tape;
+ * and the exact hit test in one voxel (RENDER.md, "--exact"). */
+#ifndef EXACT_SCENE_H
+#define EXACT_SCENE_H
+
+#include <stdint.h>
+
+#include "common/expr/tape.h"
+#include "format/oct.h"
+#include "render/exact_hit.h"
+#include "render/trace.h"
+
+/* Coarse depth (docs/perf-log.md, "render --exact"). */
+#define EXACT_CELL_DEPTH 5
+#define EXACT_CELL_MAX_DEPTH 7 /* 8^7 map entries: 8 MiB */
+
+/* One surface in one coarse cell. */
+typedef struct exact_cand {
+    uint32_t surface; /* palette index */
+    tape t;           /* pruned for the cell, as exact as the whole tape (points,
+                         derivative); arrays in the scene's pools */
+    tape cull;        /* pruned coarsely, for the interval that drops segments */
+} exact_cand;
+
+typedef struct exact_scene {
+    const oct_tree *tree;
+    unsigned depth;      /* coarse depth D, <= tree->levels */
+    uint32_t *cell_slot; /* 8^D entries, x + 2^D y + 4^D z: index into first[], or UINT32_MAX */
+    uint32_t *first;     /* ncells + 1 offsets into cand[] */
+    exact_cand *cand;
+    uint32_t ncells, ncand;
+    uint32_t max_n;      /* most instructions of any tape (scratch size) */
+    uint64_t whole_insns, pruned_insns, cull_insns; /* statistics: sum over candidates */
+    double h;            /* world units per voxel: edge / 2^L */
+    tape_insn *insn_pool;
+    tape_const *konst_pool;
+} exact_scene;
+
+/* Prepares `tapes` (tree->surface_count of them, palette order; borrowed
+ * only while this runs) for the tree at coarse depth `depth` (clamped to
+ * the tree's levels and EXACT_CELL_MAX_DEPTH). Returns 0, or -1 when out of
+ * memory (then *es holds nothing). */
+int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, unsigned depth);
+void exact_scene_free(exact_scene *es); /* accepts a zeroed or freed one */
+
+/* A thread's state for the exact test: the scene and scratch for its tapes. */
+typedef struct exact_worker {
+    const exact_scene *scene;
+    exact_scratch scratch;
+} exact_worker;
+
+int exact_worker_init(exact_worker *w, const exact_scene *es); /* 0, or -1: out of memory */
+void exact_worker_free(exact_worker *w);
+
+/* The exact test in occupied voxel v (integer corner), which the ray r
+ * occupies for local t in [t_in, t_out]: the nearest root of any surface
+ * present in v's coarse cell on that span, widened by 2^-16 of a voxel each
+ * way (so that a root the rasterizer's and this test's roundings put on
+ * different sides of a voxel face is not lost; any root found is a root of
+ * f, and nearer ones would lie in voxels already tested). Returns 1 on a
+ * hit, with its local t in *t_hit and hit's exact (1), surface and unit
+ * normal (facing the viewer) filled; the caller sets the rest. */
+int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
+                double t_out, double *t_hit, trace_hit *hit);
+
+#endif
