@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "common/atomic_file.h"
+
 /* Bytes of a w x h 8-bit RGB image in *out; -1 when that overflows size_t. */
 int image_rgb_size(uint32_t w, uint32_t h, size_t *out);
 
@@ -31,5 +33,12 @@ int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t 
  * normal images). Same return convention. */
 int image_write_pfm_rgb(const char *path, const float *values, uint32_t w, uint32_t h,
                         const char **failed_op);
+
+/* The same three images written into an open atomic_file, left for the
+ * caller to commit (with others: atomic_file_commit_all) or abort. Return 0,
+ * or -1 with errno (EOVERFLOW: the size). */
+int image_png_to(atomic_file *af, const uint8_t *rgb, uint32_t w, uint32_t h);
+int image_pfm_to(atomic_file *af, const float *values, uint32_t w, uint32_t h);
+int image_pfm_rgb_to(atomic_file *af, const float *values, uint32_t w, uint32_t h);
 
 #endif
