@@ -11,6 +11,8 @@
 #include "common/atomic_file.h"
 #include "common/diag.h"
 #include "common/limits.h"
+#include "common/output_path.h"
+#include "common/output_set.h"
 #include "common/parse_num.h"
 #include "common/test_hooks.h"
 #include "common/version.h"
@@ -75,22 +77,34 @@ static long peak_rss_kib(void)
     return getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_maxrss : 0;
 }
 
-static void print_summary(const char *out, unsigned levels, const build_stats *st, uint64_t bytes,
-                          double seconds)
+static void print_summary(FILE *to, const char *out, unsigned levels, const build_stats *st,
+                          uint64_t bytes, double seconds)
 {
-    printf("rasterize: %s: levels %u (%u^3), %llu voxels, %llu nodes, %llu bytes (%.2f bytes/voxel)\n",
+    fprintf(to, "rasterize: %s: levels %u (%u^3), %llu voxels, %llu nodes, %llu bytes (%.2f bytes/voxel)\n",
            out, levels, 1u << levels, (unsigned long long)st->voxels, (unsigned long long)st->nodes,
            (unsigned long long)bytes, st->voxels ? (double)bytes / (double)st->voxels : 0.0);
-    printf("rasterize: evaluations: %llu interval, %llu interval-gradient, %llu point; "
+    fprintf(to, "rasterize: evaluations: %llu interval, %llu interval-gradient, %llu point; "
            "pruning ran %.1f%% of the instructions; %llu voxels dropped by the Taylor test\n",
            (unsigned long long)st->interval_evals, (unsigned long long)st->gradient_evals,
            (unsigned long long)st->point_evals,
            st->insns_full ? 100.0 * (double)st->insns_evaluated / (double)st->insns_full : 100.0,
            (unsigned long long)st->taylor_drops);
-    printf("rasterize: %llu cells where f may be undefined, %llu normal fallbacks; "
+    fprintf(to, "rasterize: %llu cells where f may be undefined, %llu normal fallbacks; "
            "%.3f s, peak memory %.1f MiB\n",
            (unsigned long long)st->nan_cells, (unsigned long long)st->normal_fallbacks, seconds,
            (double)peak_rss_kib() / 1024.0);
+}
+
+/* One file in two roles, or an output that cannot be written: refused
+ * before the scene is even read. Returns EXIT_OK or the exit status. */
+static int check_files(const char *scene_path, const char *out_path)
+{
+    const output_use uses[2] = {{scene_path, "the scene", 0, 1}, {out_path, "-o", 0, 0}};
+    char msg[2 * 4096 + 256];
+    int rc = output_set_check(uses, 2, msg, sizeof msg);
+    if (rc != EXIT_OK)
+        diag_error("%s", rc < 0 ? "out of memory" : msg);
+    return rc < 0 ? EXIT_RUNTIME : rc;
 }
 
 int main(int argc, char **argv)
@@ -157,6 +171,10 @@ int main(int argc, char **argv)
     if (!out_path)
         return diag_usage_error(usage_text, "%s", "missing -o OUT.oct");
 
+    int checked = check_files(scene_path, out_path);
+    if (checked != EXIT_OK)
+        return checked;
+
     int status = EXIT_RUNTIME;
     scene *sc = NULL;
     oct_writer *w = NULL;
@@ -210,7 +228,7 @@ int main(int argc, char **argv)
         goto done;
     }
     if (!quiet)
-        print_summary(out_path, (unsigned)levels, &st, bytes, now_seconds() - t0);
+        print_summary(output_path_is_stdout(out_path) ? stderr : stdout, out_path, (unsigned)levels, &st, bytes, now_seconds() - t0);
     status = EXIT_OK;
 done:
     atomic_file_abort(af);

@@ -18,6 +18,7 @@
 #include "common/version.h"
 #include "format/oct.h"
 #include "render/frame.h"
+#include "render/outputs.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/views.h"
@@ -120,13 +121,6 @@ static char *read_text(const char *path)
         buf[n] = '\0';
     errno = e;
     return buf;
-}
-
-/* True when path ends in ".pfm": --normals then writes float normals. */
-static int is_pfm(const char *path)
-{
-    size_t n = strlen(path);
-    return n >= 4 && strcmp(path + n - 4, ".pfm") == 0;
 }
 
 /* A view that frames the root cube: aim at its centre from the direction of
@@ -382,8 +376,8 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     int want_depth = 0, want_nrm = 0, want_nrm_f = 0;
     for (size_t k = 0; k < nviews; k++) {
         want_depth |= list[k].depth != NULL;
-        want_nrm |= list[k].normals != NULL && !is_pfm(list[k].normals);
-        want_nrm_f |= list[k].normals != NULL && is_pfm(list[k].normals);
+        want_nrm |= list[k].normals != NULL && !outputs_is_pfm(list[k].normals);
+        want_nrm_f |= list[k].normals != NULL && outputs_is_pfm(list[k].normals);
     }
     if (want_depth)
         buf->depth = malloc(max_px * sizeof *buf->depth);
@@ -420,8 +414,8 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
         shade_default_light(cam, job.shade.light);
     job.rgb = buf->rgb;
     job.depth = v->depth ? buf->depth : NULL;
-    job.normals = v->normals && !is_pfm(v->normals) ? buf->nrm : NULL;
-    job.normals_f = v->normals && is_pfm(v->normals) ? buf->nrm_f : NULL;
+    job.normals = v->normals && !outputs_is_pfm(v->normals) ? buf->nrm : NULL;
+    job.normals_f = v->normals && outputs_is_pfm(v->normals) ? buf->nrm_f : NULL;
     job.threads = (unsigned)o->threads;
     job.beam_size = (unsigned)o->beam;
     if (!o->quiet && diag_stderr_is_tty())
@@ -432,22 +426,10 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     double ms = now_ms() - t0;
     *total_ms += ms;
     *total_rays += st.rays;
-    const char *op = NULL;
     const uint32_t w = (uint32_t)v->width, h = (uint32_t)v->height;
-    if (image_write_png(v->out, buf->rgb, w, h, &op) != 0) {
-        diag_path_error(v->out, "%s: %s", op ? op : "write", strerror(errno));
+    outputs_images img = {buf->rgb, buf->nrm, buf->depth, buf->nrm_f, w, h};
+    if (outputs_write_view(v, &img) != EXIT_OK)
         return EXIT_RUNTIME;
-    }
-    if (v->depth && image_write_pfm(v->depth, buf->depth, w, h, &op) != 0) {
-        diag_path_error(v->depth, "%s: %s", op ? op : "write", strerror(errno));
-        return EXIT_RUNTIME;
-    }
-    if (v->normals &&
-        (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, buf->nrm_f, w, h, &op)
-                            : image_write_png(v->normals, buf->nrm, w, h, &op)) != 0) {
-        diag_path_error(v->normals, "%s: %s", op ? op : "write", strerror(errno));
-        return EXIT_RUNTIME;
-    }
     if (!o->quiet)
         fprintf(stderr, "render: %s: %ux%u, %.1f ms, %.2f Mrays/s, %.1f%% hit\n", v->out, w, h,
                 ms, ms > 0 ? (double)st.rays / ms / 1e3 : 0.0,
@@ -506,6 +488,8 @@ int main(int argc, char **argv)
     }
     if (!o.views_path)
         status = command_line_views(tree, &o, &o.base, &list, &nviews);
+    if (status == EXIT_OK)
+        status = outputs_check(o.oct_path, o.views_path, list, nviews);
     if (status == EXIT_OK)
         status = prepare_views(tree, o.views_path, list, nviews, &cams, &buf);
     if (status != EXIT_OK)
