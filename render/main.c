@@ -89,40 +89,6 @@ static void report_line(void *ctx, unsigned line, const char *msg)
     fprintf(stderr, "%s:%u: %s\n", c->path, line, msg);
 }
 
-/* Reads a whole text file into a malloc'ed NUL-terminated buffer. */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 4096, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (n + 1 < cap) {
-            if (ferror(f)) {
-                free(buf);
-                buf = NULL;
-            }
-            break;
-        }
-        char *nb = realloc(buf, cap * 2);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    int e = errno;
-    fclose(f);
-    if (buf)
-        buf[n] = '\0';
-    errno = e;
-    return buf;
-}
-
 /* A view that frames the root cube: aim at its centre from the direction of
  * the benchmark view, far enough that its bounding sphere fits the fov. */
 static void frame_cube(const oct_tree *t, views_view *v)
@@ -203,9 +169,10 @@ static int check_args(const render_args *o)
         return diag_usage_error(usage_text, "%s", "-o goes into the views file with --views");
     if (!o->views_path && !o->base.out && !o->info)
         return diag_usage_error(usage_text, "%s", "no output: give -o OUT.png or --views FILE");
-    if (o->orbit && views_check_pattern(o->base.out) != 0)
-        return diag_usage_error(usage_text, "--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
-                           o->base.out);
+    int pattern = o->orbit ? views_check_pattern(o->base.out) : 0;
+    if (pattern != 0)
+        return diag_usage_error(usage_text, "--orbit: -o '%s': %s", o->base.out,
+                                views_orbit_strerror(pattern == -2 ? VIEWS_ORBIT_WIDTH : VIEWS_ORBIT_PATTERN));
     if (o->orbit && (o->base.depth || o->base.normals))
         return diag_usage_error(usage_text, "%s", "--orbit writes colour images only (no --depth or --normals)");
     return -1;
@@ -267,8 +234,14 @@ static int parse_args(int argc, char **argv, render_args *o)
 static int load_views_file(const render_args *o, const views_view *base, char **text,
                            views_view **list, size_t *nviews)
 {
-    *text = read_text(o->views_path);
-    if (!*text) {
+    unsigned line = 0, col = 0;
+    const char *what = NULL;
+    int rr = views_read_file(o->views_path, text, &line, &col, &what);
+    if (rr == -2) {
+        diag_at(o->views_path, line, col, "%s", what);
+        return EXIT_USAGE;
+    }
+    if (rr != 0) {
         diag_path_error(o->views_path, "%s", strerror(errno));
         return EXIT_RUNTIME;
     }
@@ -317,9 +290,13 @@ static int command_line_views(const oct_tree *tree, const render_args *o, views_
 {
     frame_cube(tree, base);
     if (o->orbit) {
-        *list = views_orbit(base, (unsigned)o->orbit, base->out);
-        if (!*list)
-            return diag_usage_error(usage_text, "%s", "--orbit: the eye lies on the up axis through the target");
+        views_orbit_err e = views_orbit(base, (unsigned)o->orbit, base->out, list);
+        if (e == VIEWS_ORBIT_NOMEM) {
+            diag_error("--orbit: out of memory for %ld views", o->orbit);
+            return EXIT_RUNTIME;
+        }
+        if (e != VIEWS_ORBIT_OK)
+            return diag_usage_error(usage_text, "--orbit: %s", views_orbit_strerror(e));
         *nviews = (size_t)o->orbit;
         return EXIT_OK;
     }

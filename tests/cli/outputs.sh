@@ -36,7 +36,7 @@ still_device /dev/full 7
 
 # A FIFO gets the image through it and stays a FIFO.
 mkfifo "$T/pipe"
-cat "$T/pipe" > "$T/from_pipe" &
+timeout 20 cat "$T/pipe" > "$T/from_pipe" &
 reader=$!
 expect_exit 0 "$BIN/render" "$T/s.oct" -o "$T/pipe" --size 16x16 -q
 wait $reader
