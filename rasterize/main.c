@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "common/atomic_file.h"
+#include "common/close_stdout.h"
 #include "common/diag.h"
 #include "common/limits.h"
 #include "common/output_path.h"
@@ -107,7 +108,7 @@ static int check_files(const char *scene_path, const char *out_path)
     return rc < 0 ? EXIT_RUNTIME : rc;
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     diag_set_progname("rasterize");
     test_hooks_init();
@@ -236,3 +237,5 @@ done:
     scene_free(sc);
     return status;
 }
+
+int main(int argc, char **argv) { return close_stdout(run(argc, argv)); }

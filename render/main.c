@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "common/view/camera.h"
+#include "common/close_stdout.h"
 #include "common/diag.h"
 #include "common/limits.h"
 #include "common/view/image.h"
@@ -433,7 +434,7 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
     return EXIT_OK;
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     diag_set_progname("render");
     test_hooks_init();
@@ -488,3 +489,5 @@ done:
     oct_close(file);
     return status;
 }
+
+int main(int argc, char **argv) { return close_stdout(run(argc, argv)); }
