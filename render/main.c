@@ -36,7 +36,7 @@ static const char usage_text[] =
 static const char help_text[] =
     "\n"
     "Ray traces the voxels of FILE.oct (two-step discrete ray tracing).\n"
-    "  -o OUT.png          colour image (8-bit sRGB PNG)\n"
+    "  -o OUT.png          colour image (8-bit sRGB PNG; '-': standard output)\n"
     "  --size WxH          image size in pixels (default 512x512, each 1.." LIMIT_STR(CAMERA_MAX_SIZE) ")\n"
     "  --eye, --target     camera position and aim (default: a view framing the cube)\n"
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
