@@ -2,8 +2,6 @@
  * Pattern from git's tempfile.c and SQLite's unixSync; see atomic_file.h. */
 #include "common/atomic_file.h"
 
-#include "common/output_path.h"
-
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -14,6 +12,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "common/output_path.h"
+
 struct atomic_file {
     FILE *fp;  /* a cookie stream over fd, so the fault hook sees every write */
     int fd;
@@ -22,7 +22,7 @@ struct atomic_file {
     char *dir;
     int registered; /* in the signal handler's table */
     int made;       /* the temporary exists */
-    int direct; /* a device, FIFO or stdout: written in place, no rename */
+    int direct;     /* a device, FIFO or stdout: written in place, no rename */
 };
 
 /* Temporary files alive right now, for the signal handler. A fixed table:

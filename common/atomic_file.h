@@ -24,7 +24,9 @@
 
 typedef struct atomic_file atomic_file;
 
-/* Creates the temporary file. Returns NULL with errno set on failure. */
+/* Creates the temporary file (or, for "-", a device or a FIFO, opens the
+ * target itself). Returns NULL with errno set on failure: EISDIR for a
+ * directory, ELOOP for a symlink loop, open's or mkstemp's errors. */
 atomic_file *atomic_file_open(const char *target_path);
 
 /* The stream to write to; valid until commit or abort. */

@@ -97,6 +97,29 @@ static void print_summary(FILE *to, const char *out, unsigned levels, const buil
            (double)peak_rss_kib() / 1024.0);
 }
 
+/* Writes the finished tree to out_path, all or nothing (atomic_file.h).
+ * Returns 0, or -1 after the message. */
+static int write_output(oct_writer *w, const char *out_path, uint64_t *bytes)
+{
+    atomic_file *af = atomic_file_open(out_path);
+    if (!af) {
+        diag_path_error(out_path, "%s", strerror(errno));
+        return -1;
+    }
+    oct_err err = oct_writer_finish(w, atomic_file_stream(af), bytes);
+    if (err != OCT_OK) {
+        diag_path_error(out_path, "write: %s", err == OCT_EIO ? strerror(errno) : oct_strerror(err));
+        atomic_file_abort(af);
+        return -1;
+    }
+    const char *op = NULL;
+    if (atomic_file_commit(af, &op) != 0) {
+        diag_path_error(out_path, "%s: %s", op, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
 /* One file in two roles, or an output that cannot be written: refused
  * before the scene is even read. Returns EXIT_OK or the exit status. */
 static int check_files(const char *scene_path, const char *out_path)
@@ -180,7 +203,6 @@ static int run(int argc, char **argv)
     int status = EXIT_RUNTIME;
     scene *sc = NULL;
     oct_writer *w = NULL;
-    atomic_file *af = NULL;
     double t0 = now_seconds();
     scene_error serr;
     if (scene_load(scene_path, &sc, &serr) != 0) {
@@ -211,29 +233,14 @@ static int run(int argc, char **argv)
         goto done;
     }
 
-    af = atomic_file_open(out_path);
-    if (!af) {
-        diag_path_error(out_path, "%s", strerror(errno));
-        goto done;
-    }
     uint64_t bytes = 0;
-    err = oct_writer_finish(w, atomic_file_stream(af), &bytes);
-    if (err != OCT_OK) {
-        diag_path_error(out_path, "write: %s", err == OCT_EIO ? strerror(errno) : oct_strerror(err));
+    if (write_output(w, out_path, &bytes) != 0)
         goto done;
-    }
-    const char *op = NULL;
-    atomic_file *committing = af;
-    af = NULL;
-    if (atomic_file_commit(committing, &op) != 0) {
-        diag_path_error(out_path, "%s: %s", op, strerror(errno));
-        goto done;
-    }
     if (!quiet)
-        print_summary(output_path_is_stdout(out_path) ? stderr : stdout, out_path, (unsigned)levels, &st, bytes, now_seconds() - t0);
+        print_summary(output_path_is_stdout(out_path) ? stderr : stdout, out_path, (unsigned)levels,
+                      &st, bytes, now_seconds() - t0);
     status = EXIT_OK;
 done:
-    atomic_file_abort(af);
     oct_writer_free(w);
     scene_free(sc);
     return status;
