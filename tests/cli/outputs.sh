@@ -44,9 +44,10 @@ wait $reader
 [ "$(sig "$T/from_pipe")" = $png_sig ] || fail "no PNG came through the FIFO"
 
 # '-' is stdout, for both programs.
-"$BIN/render" "$T/s.oct" -o - --size 16x16 -q > "$T/stdout.png" || fail "render -o -"
+(cd "$T" && "$BIN/render" s.oct -o - --size 16x16 -q > stdout.png) || fail "render -o -"
 [ "$(sig "$T/stdout.png")" = $png_sig ] || fail "render -o - wrote no PNG"
-"$BIN/rasterize" "$T/s.scene" -o - --levels 4 > "$T/stdout.oct" 2>"$ERR" || fail "rasterize -o -"
+(cd "$T" && "$BIN/rasterize" s.scene -o - --levels 4 > stdout.oct 2>"$ERR") || fail "rasterize -o -"
+expect_err "rasterize: -: levels 4"  # the summary went to stderr
 expect_exit 0 "$BIN/render" "$T/stdout.oct" -o "$T/from_stdout.png" --size 16x16 -q
 [ -e "$T/-" ] && fail "'-' created a file named -"
 
