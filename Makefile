@@ -71,7 +71,8 @@ endif
 #                                     tapes, intervals)
 #   common/view/     + common/        cameras and images
 #   rasterize/       + common/expr/ common/ format/
-#   render/          + common/view/ common/ format/  (no expression engine)
+#   render/          + common/view/ common/expr/ common/ format/  (the expression
+#                    engine evaluates the surface tapes a 1.1 file stores)
 #   bench/           + render/ common/expr/ common/view/ common/ format/
 #                    (measurement tools and their helpers, bench/README.md;
 #                    bench/tree_util builds synthetic trees for bench and tests)
@@ -103,7 +104,7 @@ LIB_BENCH     := $(B)/libbench.a
 LIB_TEST      := $(B)/libtestutil.a
 
 LIBS_RASTERIZE = $(LIB_RASTERIZE) $(LIB_EXPR) $(1) $(LIB_FORMAT)
-LIBS_RENDER    = $(LIB_RENDER) $(LIB_VIEW) $(LIB_FORMAT) $(1)
+LIBS_RENDER    = $(LIB_RENDER) $(LIB_VIEW) $(LIB_EXPR) $(LIB_FORMAT) $(1)
 LIBS_BENCH     = $(LIB_BENCH) $(LIB_RENDER) $(LIB_EXPR) $(LIB_VIEW) $(1) $(LIB_FORMAT)
 LIBS_TEST      = $(LIB_TEST) $(LIB_BENCH) $(LIB_RENDER) $(LIB_RASTERIZE) $(LIB_EXPR) $(LIB_VIEW) \
                  $(LIB_COMMON_HOOKS) $(LIB_FORMAT)

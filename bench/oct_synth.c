@@ -106,7 +106,14 @@ void test_tree_free(test_tree *t)
 
 oct_err test_tree_write(const test_tree *t, unsigned char **buf, size_t *len)
 {
-    oct_writer_params p = {0};
+    oct_writer_params none = {0};
+    return test_tree_write_1_1(t, &none, buf, len);
+}
+
+oct_err test_tree_write_1_1(const test_tree *t, const oct_writer_params *v11, unsigned char **buf,
+                            size_t *len)
+{
+    oct_writer_params p = *v11; /* flags, shard fields, function */
     p.levels = t->levels;
     memcpy(p.origin, t->origin, sizeof p.origin);
     p.edge = t->edge;
@@ -159,7 +166,9 @@ void test_oct_refresh_crcs(unsigned char *buf, size_t len)
 {
     if (len < OCT_HEADER_SIZE)
         return;
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+    /* a 1.0 file has five section entries, later minors six */
+    const int nsec = rd_u16le(buf + OCT_OFF_MINOR) == 0 ? OCT_SEC_COUNT_1_0 : OCT_SEC_COUNT;
+    for (int k = 0; k < nsec; k++) {
         unsigned char *e = buf + OCT_SEC_OFF(k);
         uint64_t off = rd_u64le(e), size = rd_u64le(e + 8);
         if (off > len || size > len - off)

@@ -34,6 +34,10 @@ void test_tree_free(test_tree *t);
 /* Writes the tree through the streaming writer (depths fed in random-size
  * chunks, deepest first) into a malloc'd buffer. Returns the writer's error. */
 oct_err test_tree_write(const test_tree *t, unsigned char **buf, size_t *len);
+/* The same with v11's format 1.1 fields (flags, shard fields, function;
+ * everything else comes from t). */
+oct_err test_tree_write_1_1(const test_tree *t, const oct_writer_params *v11, unsigned char **buf,
+                            size_t *len);
 
 /* Recomputes the header's section CRCs and the header CRC after a test has
  * edited a file, so that a check other than the CRC's is exercised. Uses the

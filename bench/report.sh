@@ -58,14 +58,22 @@ if [ "$(wc -l <"$RES/povray.csv")" -gt 1 ]; then
     echo "|---|---|---|---|---|---|---|---|---|"
     awk -F, 'NR > 1 { printf "| %s | %d² | %s | %.2f | %.3f | %.1f | %.1f | %.3f | %s |\n", $6, $7, $8, $10, 100 * $11, $12, $13, 100 * $14, $15 }' "$RES/povray.csv"
 fi
+if [ -f "$RES/shard_summary.txt" ]; then
+    echo
+    echo "Sharded rasterization (\`bench/shard.sh\`: the shards run two at a time on this machine, then \`--merge\`;"
+    echo "the merged file is the whole run's byte for byte; the projection is the longest-first makespan"
+    echo "of the measured shard CPU times on W workers):"
+    echo
+    sed 's/^/    /' "$RES/shard_summary.txt"
+fi
 echo
 cat "$RES/figure4.md"
 echo
-for p in error_vs_time p99_vs_time rasterize_time rasterize_bytes; do
+for p in error_vs_time p99_vs_time rasterize_time rasterize_bytes shard_scale; do
     [ -f "$RES/$p.png" ] && echo "![$p]($RES/$p.png)"
 done
 echo
-echo "CSV files: \`$RES/\` (rasterize, render, refcast, figure4, povray)."
+echo "CSV files: \`$RES/\` (rasterize, render, refcast, figure4, povray, shard, shard_scale)."
 echo "<!-- bench:end -->"
 } >"$T.new"
 if grep -q '<!-- bench:begin -->' "$README"; then

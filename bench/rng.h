@@ -2,8 +2,8 @@
  * Each caller keeps its own state and seed, so a suite draws the same
  * sequence wherever it calls from. Header-only (static inline): it needs no
  * library and so serves tests, fuzz targets and bench tools alike. */
-#ifndef TESTS_RNG_H
-#define TESTS_RNG_H
+#ifndef BENCH_RNG_H
+#define BENCH_RNG_H
 
 #include <stdint.h>
 

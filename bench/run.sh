@@ -216,6 +216,12 @@ else
     echo "bench: povray not installed: no peer comparison (apt-get install povray)"
 fi
 
+# ---- Sharded rasterization (bench/shard.sh): overhead, merge, projection ----
+case $MODE in
+quick) BIN="$BIN" RES="$RES" WORK="$WORK/shard" sh "$D/shard.sh" blobs_a 8 8 ;;
+full) BIN="$BIN" RES="$RES" WORK="$WORK/shard" sh "$D/shard.sh" blobs_a 12 64 ;;
+esac
+
 # ---- Plots and the report ----
 if have gnuplot; then
     gnuplot -e "res='$RES'" "$D/plots.gp" && echo "bench: plots in $RES/*.png"

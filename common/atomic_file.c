@@ -174,6 +174,17 @@ static ssize_t cookie_write(void *cookie, const char *data, size_t n)
     return (ssize_t)n;
 }
 
+/* Seeking lets a writer fill in a header last (rasterize --merge). */
+static int cookie_seek(void *cookie, off64_t *pos, int whence)
+{
+    atomic_file *af = cookie;
+    off_t r = lseek(af->fd, (off_t)*pos, whence);
+    if (r < 0)
+        return -1;
+    *pos = (off64_t)r;
+    return 0;
+}
+
 static int cookie_close(void *cookie)
 {
     atomic_file *af = cookie;
@@ -259,7 +270,7 @@ atomic_file *atomic_file_open(const char *target_path)
         errno = e;
         return NULL;
     }
-    cookie_io_functions_t io = {NULL, cookie_write, NULL, cookie_close};
+    cookie_io_functions_t io = {NULL, cookie_write, cookie_seek, cookie_close};
     af->fp = fopencookie(af, "wb", io);
     if (!af->fp) {
         int e = errno;

@@ -29,7 +29,8 @@ typedef struct atomic_file atomic_file;
  * directory, ELOOP for a symlink loop, open's or mkstemp's errors. */
 atomic_file *atomic_file_open(const char *target_path);
 
-/* The stream to write to; valid until commit or abort. */
+/* The stream to write to (seekable, except when the target is "-", a FIFO
+ * or a device that cannot seek); valid until commit or abort. */
 FILE *atomic_file_stream(atomic_file *af);
 
 /* Writes n bytes, honouring the fault hook; returns 0 or -1 with errno. */

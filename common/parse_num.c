@@ -127,3 +127,27 @@ parse_err parse_size(const char *s, long max, long *w, long *h)
         return e;
     return parse_long(x + 1, 1, max, h);
 }
+
+parse_err parse_index_of(const char *s, long max, long *index, long *count)
+{
+    if (!s || !*s)
+        return PARSE_EMPTY;
+    const char *slash = strchr(s, '/');
+    if (!slash || slash == s || slash[1] == '\0')
+        return PARSE_SYNTAX;
+    char buf[64];
+    size_t n = (size_t)(slash - s);
+    if (n >= sizeof buf)
+        return PARSE_SYNTAX;
+    memcpy(buf, s, n);
+    buf[n] = '\0';
+    long i, c;
+    parse_err e = parse_long(slash + 1, 1, max, &c);
+    if (e == PARSE_OK)
+        e = parse_long(buf, 0, c - 1, &i);
+    if (e != PARSE_OK)
+        return e;
+    *index = i;
+    *count = c;
+    return PARSE_OK;
+}

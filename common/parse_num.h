@@ -26,5 +26,8 @@ parse_err parse_double(const char *s, double *out);                 /* finite */
 parse_err parse_long(const char *s, long min, long max, long *out); /* decimal integer */
 parse_err parse_vec3(const char *s, double out[3]);                 /* "X,Y,Z" */
 parse_err parse_size(const char *s, long max, long *w, long *h);    /* "WxH", 1..max each */
+/* "I/N" with 1 <= N <= max and 0 <= I < N (a shard or a part of N);
+ * *index and *count are set only on success. */
+parse_err parse_index_of(const char *s, long max, long *index, long *count);
 
 #endif

@@ -22,6 +22,11 @@
  * voxel centre along the normal, in voxel edges). When the scene has more than
  * one surface, a parallel uint8 array names each voxel's surface, which
  * indexes the palette.
+ *
+ * Format 1.1 adds a FUNCTION section (each surface's tape, validated in
+ * place: oct_get_function; common/expr/tape_io.c makes tapes of it), the
+ * SHELL_ONLY flag (no voxel records) and shard fields. The writer writes 1.0
+ * unless one of them is used.
  */
 #ifndef OCT_H
 #define OCT_H
@@ -33,7 +38,7 @@
 #define OCT_MAGIC "\x89OCT\r\n\x1a\n" /* 8 bytes; the 0x89 is not text */
 #define OCT_MAGIC_SIZE 8
 #define OCT_VERSION_MAJOR 1 /* a reader refuses a higher major */
-#define OCT_VERSION_MINOR 0 /* a reader accepts any minor */
+#define OCT_VERSION_MINOR 1 /* a reader accepts any minor; the writer writes 0 or 1 */
 #define OCT_MAX_LEVELS 20   /* deepest grid: 2^20 voxels a side */
 #define OCT_MAX_SURFACES 255
 
@@ -52,6 +57,7 @@ typedef enum oct_err {
     OCT_EVOXEL,    /* a voxel record out of range (surface index, normal code) */
     OCT_ECRC,      /* a CRC-32 does not match */
     OCT_EUSAGE,    /* the caller broke the API contract (writer fed out of order) */
+    OCT_EFUNCTION, /* the FUNCTION section breaks one of its invariants */
     OCT_ERR_COUNT
 } oct_err;
 
@@ -64,6 +70,38 @@ typedef struct oct_group {
     uint8_t mask[8];  /* child masks of nodes 8g..8g+7; 0 past the last node */
 } oct_group;
 _Static_assert(sizeof(oct_group) == 16, "oct_group is 16 bytes on disk");
+
+/* Header flags (every bit is "required": a reader refuses bits it does not
+ * know). SHELL_ONLY: no voxel records (VOXELS is empty although voxel_count
+ * > 0): the tree only brackets the surface; needs a FUNCTION section. */
+#define OCT_FLAG_SHELL_ONLY 1u
+#define OCT_FLAGS_KNOWN OCT_FLAG_SHELL_ONLY
+
+/* Op codes of the FUNCTION section's instructions (FORMAT.md §8). They are
+ * the file's numbers, not any in-memory enum's. */
+enum {
+    OCT_OP_CONST = 0, /* a: constant pool index; b: 0 */
+    OCT_OP_X = 1, OCT_OP_Y = 2, OCT_OP_Z = 3, /* a, b: 0 */
+    OCT_OP_NEG = 4, OCT_OP_SQUARE = 5, OCT_OP_SQRT = 6, OCT_OP_EXP = 7, OCT_OP_LOG = 8,
+    OCT_OP_ABS = 9, OCT_OP_SIN = 10, OCT_OP_COS = 11, OCT_OP_TAN = 12, /* a: slot; b: 0 */
+    OCT_OP_ADD = 13, OCT_OP_SUB = 14, OCT_OP_MUL = 15, OCT_OP_DIV = 16, OCT_OP_MIN = 17,
+    OCT_OP_MAX = 18, /* a, b: slots */
+    OCT_OP_POWC = 19, /* a: slot; b: pool index of an exact, non-integer exponent */
+    OCT_OP_COUNT = 20
+};
+#define OCT_FN_MAX_INSNS (1u << 22)  /* per tape (the expression engine's limit) */
+#define OCT_FN_MAX_CONSTS (1u << 22) /* per tape */
+
+/* One surface's tape in a validated FUNCTION section, in place in the file:
+ * insn[3i], insn[3i+1], insn[3i+2] are instruction i's op (OCT_OP_*), a and
+ * b; konst[3j..3j+2] are constant j's v, lo, hi. Every invariant of FORMAT.md
+ * §8 holds: known ops, operands strictly earlier, pool indices in range,
+ * root < insn_count, constants finite with lo <= v <= hi. */
+typedef struct oct_function_tape {
+    uint32_t insn_count, const_count, root;
+    const uint32_t *insn;
+    const double *konst; /* NULL when const_count is 0 */
+} oct_function_tape;
 
 /* Voxel record fields. */
 #define OCT_VOXEL_NORMAL_BITS 24u
@@ -81,7 +119,7 @@ typedef struct oct_tree {
     uint64_t node_count[OCT_MAX_LEVELS];   /* nodes at each depth; [0] is 0 or 1 */
     uint64_t voxel_count;
     const oct_group *groups[OCT_MAX_LEVELS]; /* per depth, ceil(count/8) groups */
-    const uint32_t *voxels;                /* voxel_count records */
+    const uint32_t *voxels;                /* voxel_count records; NULL in a shell-only file */
     const uint8_t *surfaces;               /* voxel_count indices, NULL if surface_count <= 1 */
     uint32_t surface_count;                /* 1..OCT_MAX_SURFACES */
     const float *palette;                  /* surface_count linear RGB triples in [0,1] */
@@ -132,6 +170,15 @@ enum {
 /* Facts of the header that are not part of the tree view. */
 typedef struct oct_info {
     uint16_t version_major, version_minor;
+    uint32_t flags;            /* OCT_FLAG_* */
+    /* Shard fields (1.1; all 0 for a whole file): shard shard_index of a
+     * shard_count-way partition of the cells of depth shard_depth, in Morton
+     * order; it holds the voxels whose depth-k ancestor c has morton_lo <= c
+     * < morton_hi; partition_crc is the CRC-32 of the N+1 boundaries. */
+    uint32_t shard_count, shard_index, shard_depth, partition_crc;
+    uint64_t morton_lo, morton_hi;
+    const void *function;      /* the FUNCTION section's bytes, NULL when absent */
+    uint64_t function_size;
     uint32_t root_depth;       /* depth of this tree's root in the whole grid */
     uint64_t root_cell[3];     /* integer cell coordinates of the root at root_depth */
     double grid_origin[3];     /* world min corner of the whole grid */
@@ -146,6 +193,20 @@ typedef struct oct_info {
  * failed (0 when not applicable). errno is meaningful for OCT_EIO. */
 oct_err oct_open(const char *path, unsigned flags, oct_file **out, uint64_t *err_offset);
 
+/* Where and why validation failed: the byte offset of the failing field
+ * and a static English phrase naming the broken rule (for the FUNCTION
+ * section, the invariant; otherwise oct_strerror's text without its
+ * "corrupt: " prefix). Never NULL after a failed open. */
+typedef struct oct_fault {
+    uint64_t offset;
+    const char *what;
+} oct_fault;
+
+/* oct_open and oct_open_memory with the fault described; `fault` may be NULL. */
+oct_err oct_open_fault(const char *path, unsigned flags, oct_file **out, oct_fault *fault);
+oct_err oct_open_memory_fault(const void *data, size_t size, unsigned flags, oct_file **out,
+                              oct_fault *fault);
+
 /* The same over a caller's buffer, which must outlive the oct_file and is
  * not copied. Any alignment is accepted (misaligned data is copied once). */
 oct_err oct_open_memory(const void *data, size_t size, unsigned flags, oct_file **out,
@@ -154,6 +215,9 @@ oct_err oct_open_memory(const void *data, size_t size, unsigned flags, oct_file 
 void oct_close(oct_file *f); /* accepts NULL */
 const oct_tree *oct_get_tree(const oct_file *f);
 const oct_info *oct_get_info(const oct_file *f);
+/* The validated tapes of the FUNCTION section, tree.surface_count of them in
+ * palette order, or NULL when the file stores no function. */
+const oct_function_tape *oct_get_function(const oct_file *f);
 
 /* Prints the human summary `render --info` shows (format version, levels,
  * cube, nodes per depth, voxels, file bytes, bytes per voxel) to `out`, a
@@ -172,6 +236,12 @@ typedef struct oct_writer_params {
     uint64_t root_cell[3];     /* 0,0,0 for a whole grid */
     uint32_t surface_count;    /* 1..OCT_MAX_SURFACES */
     const float *palette;      /* surface_count RGB triples, copied */
+    /* Format 1.1 (all zero: a 1.0 file, byte for byte as before). */
+    uint32_t flags;            /* OCT_FLAG_*; SHELL_ONLY needs `function` */
+    uint32_t shard_count, shard_index, shard_depth, partition_crc; /* oct_info's meaning */
+    uint64_t morton_lo, morton_hi;
+    const void *function;      /* FUNCTION section bytes (FORMAT.md §8), copied; NULL: none */
+    size_t function_size;
 } oct_writer_params;
 
 /* Streaming construction. Nodes of each depth, and voxels, must be appended
@@ -181,7 +251,8 @@ typedef struct oct_writer_params {
  * itself, once. */
 oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out);
 oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks, size_t n);
-/* `surfaces` may be NULL when surface_count == 1. */
+/* `surfaces` may be NULL when surface_count == 1; `voxels` may be NULL with
+ * OCT_FLAG_SHELL_ONLY (the records are not stored then, only counted). */
 oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8_t *surfaces,
                               size_t n);
 /* Checks the counts agree (OCT_EUSAGE if not), computes bases and CRCs and

@@ -20,6 +20,8 @@ struct oct_file {
     void *owned; /* aligned copy (oct_open_memory of a misaligned buffer), or NULL */
     oct_tree tree;
     oct_info info;
+    int has_function;
+    oct_function_tape function[OCT_MAX_SURFACES];
 };
 
 static const char *const err_text[OCT_ERR_COUNT] = {
@@ -37,6 +39,7 @@ static const char *const err_text[OCT_ERR_COUNT] = {
     [OCT_EVOXEL] = "corrupt: voxel, surface or palette value out of range",
     [OCT_ECRC] = "corrupt: checksum mismatch",
     [OCT_EUSAGE] = "API misuse",
+    [OCT_EFUNCTION] = "corrupt: invalid function section",
 };
 
 const char *oct_strerror(oct_err err)
@@ -115,7 +118,9 @@ static oct_err check_tree(const unsigned char *p, uint64_t nodes_off, uint64_t l
 typedef struct layout {
     uint32_t hsize;
     int known_minor; /* minor <= ours: reserved bytes and trailing bytes are ours to check */
+    int nsec;        /* section entries: OCT_SEC_COUNT_1_0 (minor 0) or OCT_SEC_COUNT */
     uint64_t off[OCT_SEC_COUNT], len[OCT_SEC_COUNT];
+    const char *what; /* the FUNCTION check that failed, or NULL */
 } layout;
 
 /* Magic, version, header size and the byte-order marks. */
@@ -130,14 +135,19 @@ static oct_err check_identity(const unsigned char *p, uint64_t size, oct_info *i
     in->version_minor = rd_u16le(p + OCT_OFF_MINOR);
     CHECK(in->version_major == OCT_VERSION_MAJOR, OCT_EVERSION, (uint64_t)OCT_OFF_MAJOR);
     lo->known_minor = in->version_minor <= OCT_VERSION_MINOR;
+    lo->nsec = in->version_minor == 0 ? OCT_SEC_COUNT_1_0 : OCT_SEC_COUNT;
     lo->hsize = rd_u32le(p + OCT_OFF_HEADER_SIZE);
     const uint32_t hsize = lo->hsize;
-    CHECK(hsize % OCT_ALIGN == 0 && (lo->known_minor ? hsize == OCT_HEADER_SIZE : hsize >= OCT_HEADER_SIZE),
+    /* 256 for 1.0, 320 for 1.1, a multiple of 64 >= 320 for a newer minor */
+    const uint32_t least = in->version_minor == 0 ? OCT_HEADER_SIZE : OCT_HEADER_SIZE_1_1;
+    CHECK(hsize % OCT_ALIGN == 0 && (lo->known_minor ? hsize == least : hsize >= least),
           OCT_EHEADER, (uint64_t)OCT_OFF_HEADER_SIZE);
     CHECK(hsize <= size, OCT_ETRUNC, (uint64_t)OCT_OFF_HEADER_SIZE);
     CHECK(rd_u32le(p + OCT_OFF_BOM_U32) == OCT_BOM_U32, OCT_EHEADER, (uint64_t)OCT_OFF_BOM_U32);
     CHECK(rd_f64le(p + OCT_OFF_BOM_F64) == OCT_BOM_F64, OCT_EHEADER, (uint64_t)OCT_OFF_BOM_F64);
-    CHECK(rd_u32le(p + OCT_OFF_FLAGS) == 0, OCT_EHEADER, (uint64_t)OCT_OFF_FLAGS);
+    in->flags = rd_u32le(p + OCT_OFF_FLAGS);
+    CHECK(in->version_minor == 0 ? in->flags == 0 : (in->flags & ~OCT_FLAGS_KNOWN) == 0, OCT_EHEADER,
+          (uint64_t)OCT_OFF_FLAGS); /* every flag is required: unknown ones refuse the file */
     return OCT_OK;
 }
 
@@ -171,6 +181,37 @@ static oct_err check_header_fields(const unsigned char *p, oct_tree *t, oct_info
     return OCT_OK;
 }
 
+/* The shard fields of a 1.1 header: all zero for a whole file; for shard i
+ * of N, i < N, a whole-grid tree, a partition depth k <= levels and a Morton
+ * range lo <= hi <= 8^k. (That the voxels lie in the range is the merger's
+ * business, not the reader's.) */
+static oct_err check_shard_fields(const unsigned char *p, const oct_tree *t, oct_info *in,
+                                  uint64_t *where)
+{
+    if (in->version_minor == 0)
+        return OCT_OK;
+    in->shard_count = rd_u32le(p + OCT_OFF_SHARD_COUNT);
+    in->shard_index = rd_u32le(p + OCT_OFF_SHARD_INDEX);
+    in->shard_depth = rd_u32le(p + OCT_OFF_SHARD_DEPTH);
+    in->partition_crc = rd_u32le(p + OCT_OFF_PARTITION_CRC);
+    in->morton_lo = rd_u64le(p + OCT_OFF_MORTON_LO);
+    in->morton_hi = rd_u64le(p + OCT_OFF_MORTON_HI);
+    if (in->shard_count == 0) {
+        CHECK(in->shard_index == 0, OCT_EHEADER, (uint64_t)OCT_OFF_SHARD_INDEX);
+        CHECK(in->shard_depth == 0, OCT_EHEADER, (uint64_t)OCT_OFF_SHARD_DEPTH);
+        CHECK(in->partition_crc == 0, OCT_EHEADER, (uint64_t)OCT_OFF_PARTITION_CRC);
+        CHECK(in->morton_lo == 0, OCT_EHEADER, (uint64_t)OCT_OFF_MORTON_LO);
+        CHECK(in->morton_hi == 0, OCT_EHEADER, (uint64_t)OCT_OFF_MORTON_HI);
+        return OCT_OK;
+    }
+    CHECK(in->root_depth == 0, OCT_EHEADER, (uint64_t)OCT_OFF_ROOT_DEPTH); /* a shard is whole-grid */
+    CHECK(in->shard_index < in->shard_count, OCT_EHEADER, (uint64_t)OCT_OFF_SHARD_INDEX);
+    CHECK(in->shard_depth <= t->levels, OCT_EHEADER, (uint64_t)OCT_OFF_SHARD_DEPTH);
+    CHECK(in->morton_hi <= UINT64_C(1) << (3 * in->shard_depth), OCT_EHEADER, (uint64_t)OCT_OFF_MORTON_HI);
+    CHECK(in->morton_lo <= in->morton_hi, OCT_EHEADER, (uint64_t)OCT_OFF_MORTON_LO);
+    return OCT_OK;
+}
+
 /* The header's reserved fields are zero, for the minors this reader knows
  * (a newer minor may give meaning to these bytes). */
 static oct_err check_header_reserved(const unsigned char *p, const layout *lo, uint64_t *where)
@@ -179,15 +220,20 @@ static oct_err check_header_reserved(const unsigned char *p, const layout *lo, u
         return OCT_OK;
     uint64_t at;
     CHECK(rd_u32le(p + OCT_OFF_RESERVED0) == 0, OCT_ERESERVED, (uint64_t)OCT_OFF_RESERVED0);
-    for (int k = 0; k < OCT_SEC_COUNT; k++)
+    for (int k = 0; k < lo->nsec; k++)
         CHECK(rd_u32le(p + OCT_SEC_OFF(k) + 20) == 0, OCT_ERESERVED, (uint64_t)OCT_SEC_OFF(k) + 20);
-    CHECK(all_zero(p + OCT_OFF_RESERVED1, OCT_OFF_HEADER_CRC - OCT_OFF_RESERVED1, &at),
-          OCT_ERESERVED, OCT_OFF_RESERVED1 + at);
+    if (lo->nsec == OCT_SEC_COUNT_1_0)
+        CHECK(all_zero(p + OCT_OFF_RESERVED1, OCT_OFF_HEADER_CRC - OCT_OFF_RESERVED1, &at),
+              OCT_ERESERVED, OCT_OFF_RESERVED1 + at);
+    else
+        CHECK(all_zero(p + OCT_OFF_RESERVED2, OCT_OFF_HEADER_CRC_1_1 - OCT_OFF_RESERVED2, &at),
+              OCT_ERESERVED, OCT_OFF_RESERVED2 + at);
     return OCT_OK;
 }
 
-/* The byte length section k must have, given the header and level counts. */
-static uint64_t section_size(int k, const oct_tree *t)
+/* The byte length section k must have, given the header and level counts
+ * (FUNCTION describes its own length: oct__function_check). */
+static uint64_t section_size(int k, const oct_tree *t, uint32_t flags)
 {
     uint64_t want;
     switch (k) {
@@ -197,7 +243,9 @@ static uint64_t section_size(int k, const oct_tree *t)
         for (uint32_t d = 0; d < t->levels; d++)
             want += 16 * groups_of(t->node_count[d]); /* counts <= 8^d: no overflow */
         break;
-    case OCT_SEC_VOXELS: want = 4 * t->voxel_count; break; /* voxel_count <= 8^20 */
+    case OCT_SEC_VOXELS: /* voxel_count <= 8^20 */
+        want = flags & OCT_FLAG_SHELL_ONLY ? 0 : 4 * t->voxel_count;
+        break;
     case OCT_SEC_SURFACES: want = t->surface_count > 1 ? t->voxel_count : 0; break;
     default: want = 12u * t->surface_count; break;
     }
@@ -220,15 +268,18 @@ static oct_err check_level_counts(const unsigned char *p, uint64_t off, oct_tree
 /* Sections: each of the expected size, in table order, each at the first
  * 64-byte boundary after the previous one, inside the file; then no
  * trailing bytes (for a known minor). */
-static oct_err check_sections(const unsigned char *p, uint64_t size, oct_tree *t, layout *lo,
-                              uint64_t *where)
+static oct_err check_sections(const unsigned char *p, uint64_t size, oct_tree *t, const oct_info *in,
+                              layout *lo, uint64_t *where)
 {
     uint64_t end = lo->hsize;
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+    memset(lo->off, 0, sizeof lo->off);
+    memset(lo->len, 0, sizeof lo->len);
+    for (int k = 0; k < lo->nsec; k++) {
         const uint64_t e = OCT_SEC_OFF(k);
         const uint64_t off = lo->off[k] = rd_u64le(p + e);
         const uint64_t len = lo->len[k] = rd_u64le(p + e + 8);
-        CHECK(len == section_size(k, t), OCT_ESECTION, e + 8);
+        if (k != OCT_SEC_FUNCTION)
+            CHECK(len == section_size(k, t, in->flags), OCT_ESECTION, e + 8);
         if (len == 0) {
             CHECK(off == 0 && rd_u32le(p + e + 16) == 0, OCT_ESECTION, e);
         } else {
@@ -246,6 +297,9 @@ static oct_err check_sections(const unsigned char *p, uint64_t size, oct_tree *t
         }
     }
     CHECK(lo->known_minor ? size == end : size >= end, OCT_ESECTION, end); /* trailing bytes */
+    /* without voxel records, the tree needs the function to find the surface */
+    CHECK(!(in->flags & OCT_FLAG_SHELL_ONLY) || lo->len[OCT_SEC_FUNCTION] > 0, OCT_ESECTION,
+          (uint64_t)OCT_SEC_OFF(OCT_SEC_FUNCTION) + 8);
     return OCT_OK;
 }
 
@@ -255,7 +309,7 @@ static oct_err check_records(const unsigned char *p, const oct_tree *t, const la
     const uint64_t voff = lo->off[OCT_SEC_VOXELS], soff = lo->off[OCT_SEC_SURFACES];
     const uint64_t poff = lo->off[OCT_SEC_PALETTE];
     const unsigned char *v = p + voff;
-    for (uint64_t i = 0; i < t->voxel_count; i++)
+    for (uint64_t i = 0; lo->len[OCT_SEC_VOXELS] && i < t->voxel_count; i++) /* none: shell-only */
         CHECK(v[4 * i + 3] != 0x80, OCT_EVOXEL, voff + 4 * i + 3); /* offset -128 */
     if (t->surface_count > 1) {
         const unsigned char *s = p + soff;
@@ -275,7 +329,7 @@ static oct_err check_crcs(const unsigned char *p, const layout *lo, uint64_t *wh
 {
     const uint32_t hsize = lo->hsize;
     CHECK((uint32_t)crc32_z(0, p, hsize - 4) == rd_u32le(p + hsize - 4), OCT_ECRC, hsize - 4);
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+    for (int k = 0; k < lo->nsec; k++) {
         uLong c = crc32_z(0, lo->len[k] ? p + lo->off[k] : NULL, (size_t)lo->len[k]);
         CHECK((uint32_t)c == rd_u32le(p + OCT_SEC_OFF(k) + 16), OCT_ECRC, (uint64_t)OCT_SEC_OFF(k) + 16);
     }
@@ -296,45 +350,82 @@ static void set_view(oct_file *f, const layout *lo)
         g_off += 16 * groups_of(t->node_count[d]);
         in->total_nodes += t->node_count[d];
     }
-    t->voxels = t->voxel_count ? (const uint32_t *)(const void *)(p + lo->off[OCT_SEC_VOXELS]) : NULL;
+    t->voxels = lo->len[OCT_SEC_VOXELS] ? (const uint32_t *)(const void *)(p + lo->off[OCT_SEC_VOXELS]) : NULL;
     t->surfaces = t->surface_count > 1 && t->voxel_count ? p + lo->off[OCT_SEC_SURFACES] : NULL;
     t->palette = (const float *)(const void *)(p + lo->off[OCT_SEC_PALETTE]);
     in->file_size = f->size;
+    f->has_function = lo->len[OCT_SEC_FUNCTION] > 0;
+    in->function = f->has_function ? p + lo->off[OCT_SEC_FUNCTION] : NULL;
+    in->function_size = lo->len[OCT_SEC_FUNCTION];
+}
+
+/* The FUNCTION section, when there is one: its tapes into f->function. */
+static oct_err check_function(oct_file *f, layout *lo, uint64_t *where)
+{
+    const uint64_t len = lo->len[OCT_SEC_FUNCTION], off = lo->off[OCT_SEC_FUNCTION];
+    if (len == 0)
+        return OCT_OK;
+    if (oct__function_check(f->data + off, len, off, f->tree.surface_count, f->function, where,
+                            &lo->what) != 0)
+        return OCT_EFUNCTION;
+    return OCT_OK;
 }
 
 /* Every check, in this order: header, sections, tree structure, records,
  * then checksums last: a damaged file is then reported by its first broken
  * structure when it has one, and any other damage still fails here. */
-static oct_err validate(oct_file *f, unsigned flags, uint64_t *where)
+static oct_err validate(oct_file *f, unsigned flags, uint64_t *where, const char **what)
 {
     const unsigned char *p = f->data;
     oct_tree *t = &f->tree;
     layout lo;
+    lo.what = NULL;
     *where = 0;
     oct_err rc = check_identity(p, f->size, &f->info, &lo, where);
     if (rc == OCT_OK)
         rc = check_header_fields(p, t, &f->info, where);
     if (rc == OCT_OK)
+        rc = check_shard_fields(p, t, &f->info, where);
+    if (rc == OCT_OK)
         rc = check_header_reserved(p, &lo, where);
     if (rc == OCT_OK)
-        rc = check_sections(p, f->size, t, &lo, where);
+        rc = check_sections(p, f->size, t, &f->info, &lo, where);
     if (rc == OCT_OK)
         rc = check_tree(p, lo.off[OCT_SEC_NODES], lo.off[OCT_SEC_LEVELS], t, where);
     if (rc == OCT_OK)
         rc = check_records(p, t, &lo, where);
+    if (rc == OCT_OK)
+        rc = check_function(f, &lo, where);
     if (rc == OCT_OK && !(flags & OCT_OPEN_TRUST))
         rc = check_crcs(p, &lo, where);
     if (rc == OCT_OK)
         set_view(f, &lo);
+    *what = lo.what;
     return rc;
 }
 
-static oct_err finish_open(oct_file *f, unsigned flags, oct_file **out, uint64_t *err_offset)
+/* The fault's phrase for an error without a more precise one: the error's
+ * text without its "corrupt: " prefix. */
+static const char *plain_what(oct_err rc)
+{
+    const char *s = oct_strerror(rc);
+    return strncmp(s, "corrupt: ", 9) == 0 ? s + 9 : s;
+}
+
+static void set_fault(oct_fault *fault, oct_err rc, uint64_t where, const char *what)
+{
+    if (!fault)
+        return;
+    fault->offset = rc == OCT_OK ? 0 : where;
+    fault->what = rc == OCT_OK ? NULL : what ? what : plain_what(rc);
+}
+
+static oct_err finish_open(oct_file *f, unsigned flags, oct_file **out, oct_fault *fault)
 {
     uint64_t where = 0;
-    oct_err rc = validate(f, flags, &where);
-    if (err_offset)
-        *err_offset = rc == OCT_OK ? 0 : where;
+    const char *what = NULL;
+    oct_err rc = validate(f, flags, &where, &what);
+    set_fault(fault, rc, where, what);
     if (rc != OCT_OK) {
         oct_close(f);
         return rc;
@@ -345,13 +436,33 @@ static oct_err finish_open(oct_file *f, unsigned flags, oct_file **out, uint64_t
 
 oct_err oct_open(const char *path, unsigned flags, oct_file **out, uint64_t *err_offset)
 {
-    *out = NULL;
+    oct_fault fault;
+    oct_err rc = oct_open_fault(path, flags, out, &fault);
     if (err_offset)
-        *err_offset = 0;
+        *err_offset = fault.offset;
+    return rc;
+}
+
+oct_err oct_open_memory(const void *data, size_t size, unsigned flags, oct_file **out,
+                        uint64_t *err_offset)
+{
+    oct_fault fault;
+    oct_err rc = oct_open_memory_fault(data, size, flags, out, &fault);
+    if (err_offset)
+        *err_offset = fault.offset;
+    return rc;
+}
+
+oct_err oct_open_fault(const char *path, unsigned flags, oct_file **out, oct_fault *fault)
+{
+    *out = NULL;
+    set_fault(fault, OCT_OK, 0, NULL);
     /* O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below. */
     int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
-    if (fd < 0)
+    if (fd < 0) {
+        set_fault(fault, OCT_EIO, 0, NULL);
         return OCT_EIO;
+    }
     oct_err rc = OCT_OK;
     struct stat st;
     if (fstat(fd, &st) != 0) {
@@ -386,37 +497,42 @@ oct_err oct_open(const char *path, unsigned flags, oct_file **out, uint64_t *err
     }
     f->data = f->map;
     close(fd);
-    return finish_open(f, flags, out, err_offset);
+    return finish_open(f, flags, out, fault);
 fail:;
     int e = errno;
     close(fd);
+    set_fault(fault, rc, 0, NULL);
     errno = e;
     return rc;
 }
 
-oct_err oct_open_memory(const void *data, size_t size, unsigned flags, oct_file **out,
-                        uint64_t *err_offset)
+oct_err oct_open_memory_fault(const void *data, size_t size, unsigned flags, oct_file **out,
+                              oct_fault *fault)
 {
     *out = NULL;
-    if (err_offset)
-        *err_offset = 0;
-    if (!data && size)
+    set_fault(fault, OCT_OK, 0, NULL);
+    if (!data && size) {
+        set_fault(fault, OCT_EUSAGE, 0, NULL);
         return OCT_EUSAGE;
+    }
     oct_file *f = oct__calloc(1, sizeof *f);
-    if (!f)
+    if (!f) {
+        set_fault(fault, OCT_ENOMEM, 0, NULL);
         return OCT_ENOMEM;
+    }
     f->size = size;
     f->data = data ? data : (const unsigned char *)"";
     if ((uintptr_t)data % 8 != 0) { /* the view casts to uint64_t-bearing structs */
         f->owned = oct__aligned_alloc(OCT_ALIGN, oct_align_up(size ? size : 1));
         if (!f->owned) {
             free(f);
+            set_fault(fault, OCT_ENOMEM, 0, NULL);
             return OCT_ENOMEM;
         }
         memcpy(f->owned, data, size);
         f->data = f->owned;
     }
-    return finish_open(f, flags, out, err_offset);
+    return finish_open(f, flags, out, fault);
 }
 
 void oct_close(oct_file *f)
@@ -431,31 +547,4 @@ void oct_close(oct_file *f)
 
 const oct_tree *oct_get_tree(const oct_file *f) { return &f->tree; }
 const oct_info *oct_get_info(const oct_file *f) { return &f->info; }
-
-int oct_print_info(void *out_file, const oct_file *f)
-{
-    FILE *out = out_file;
-    const oct_tree *t = &f->tree;
-    const oct_info *in = &f->info;
-    fprintf(out, "format:      .oct %u.%u\n", in->version_major, in->version_minor);
-    fprintf(out, "levels:      %u (%llu voxels a side)\n", t->levels,
-            (unsigned long long)(UINT64_C(1) << t->levels));
-    fprintf(out, "cube:        origin (%.17g, %.17g, %.17g), edge %.17g\n", t->origin[0], t->origin[1],
-            t->origin[2], t->edge);
-    if (in->root_depth > 0)
-        fprintf(out, "subtree:     depth %u, cell (%llu, %llu, %llu) of the grid at (%.17g, %.17g, %.17g), edge %.17g\n",
-                in->root_depth, (unsigned long long)in->root_cell[0],
-                (unsigned long long)in->root_cell[1], (unsigned long long)in->root_cell[2],
-                in->grid_origin[0], in->grid_origin[1], in->grid_origin[2], in->grid_edge);
-    fprintf(out, "nodes:       %llu\n", (unsigned long long)in->total_nodes);
-    for (uint32_t d = 0; d < t->levels; d++)
-        fprintf(out, "  depth %2u:  %llu\n", d, (unsigned long long)t->node_count[d]);
-    fprintf(out, "voxels:      %llu\n", (unsigned long long)t->voxel_count);
-    fprintf(out, "surfaces:    %u\n", t->surface_count);
-    fprintf(out, "file bytes:  %llu\n", (unsigned long long)in->file_size);
-    if (t->voxel_count)
-        fprintf(out, "bytes/voxel: %.3f\n", (double)in->file_size / (double)t->voxel_count);
-    else
-        fprintf(out, "bytes/voxel: - (no voxels)\n");
-    return ferror(out) ? -1 : 0;
-}
+const oct_function_tape *oct_get_function(const oct_file *f) { return f->has_function ? f->function : NULL; }

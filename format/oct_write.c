@@ -14,9 +14,11 @@ struct oct_writer {
     float palette[OCT_MAX_SURFACES * 3];
     uint8_t *masks[OCT_MAX_LEVELS];
     size_t count[OCT_MAX_LEVELS], cap[OCT_MAX_LEVELS];
-    uint32_t *voxels;
+    uint32_t *voxels;   /* NULL with OCT_FLAG_SHELL_ONLY: the records are not stored */
     uint8_t *surfaces;
-    size_t voxel_count, voxel_cap;
+    size_t voxel_count, voxel_cap, surface_cap;
+    unsigned char *function; /* copy of the FUNCTION section, or NULL */
+    int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
     int done; /* finish was called: the writer accepts nothing more */
 };
 
@@ -75,6 +77,25 @@ static int grow(void **buf, size_t *cap, size_t need, size_t elem)
 
 static int finite_unit(float v) { return isfinite(v) && v >= 0.0f && v <= 1.0f; }
 
+/* The 1.1 parameters as the reader checks them (FORMAT.md §5, §8). */
+static int params_1_1_ok(const oct_writer_params *p)
+{
+    if ((p->flags & ~OCT_FLAGS_KNOWN) || ((p->flags & OCT_FLAG_SHELL_ONLY) && !p->function))
+        return 0;
+    if (p->function) {
+        uint64_t where;
+        const char *what;
+        if (oct__function_check(p->function, p->function_size, 0, p->surface_count, NULL, &where,
+                                &what) != 0)
+            return 0;
+    }
+    if (p->shard_count == 0)
+        return p->shard_index == 0 && p->shard_depth == 0 && p->partition_crc == 0 &&
+               p->morton_lo == 0 && p->morton_hi == 0;
+    return p->root_depth == 0 && p->shard_index < p->shard_count && p->shard_depth <= p->levels &&
+           p->morton_hi <= UINT64_C(1) << (3 * p->shard_depth) && p->morton_lo <= p->morton_hi;
+}
+
 oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out)
 {
     *out = NULL;
@@ -95,10 +116,23 @@ oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out)
         if (!finite_unit(p->palette[i]))
             return OCT_EUSAGE;
     }
+    if (!params_1_1_ok(p))
+        return OCT_EUSAGE;
     oct_writer *w = oct__calloc(1, sizeof *w);
     if (!w)
         return OCT_ENOMEM;
     w->p = *p;
+    w->p.function = NULL;
+    if (p->function) {
+        w->function = oct__realloc(NULL, p->function_size);
+        if (!w->function) {
+            free(w);
+            return OCT_ENOMEM;
+        }
+        memcpy(w->function, p->function, p->function_size);
+        w->p.function = w->function;
+    }
+    w->v11 = p->flags || p->function || p->shard_count;
     for (uint32_t i = 0; i < 3 * p->surface_count; i++)
         w->palette[i] = p->palette ? p->palette[i] : 0.8f;
     w->p.palette = w->palette;
@@ -128,30 +162,28 @@ oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks
 
 oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8_t *surfaces, size_t n)
 {
-    if (!w || w->done || (n && !voxels) || (n && w->p.surface_count > 1 && !surfaces))
+    const int shell = w && (w->p.flags & OCT_FLAG_SHELL_ONLY);
+    if (!w || w->done || (n && !voxels && !shell) || (n && w->p.surface_count > 1 && !surfaces))
         return OCT_EUSAGE;
     for (size_t i = 0; i < n; i++) {
-        if ((voxels[i] >> OCT_VOXEL_OFFSET_SHIFT) == 0x80u)
+        if (!shell && (voxels[i] >> OCT_VOXEL_OFFSET_SHIFT) == 0x80u)
             return OCT_EUSAGE; /* offset -128 is reserved */
         if (w->p.surface_count > 1 && surfaces[i] >= w->p.surface_count)
             return OCT_EUSAGE;
     }
     if (n > SIZE_MAX - w->voxel_count)
         return OCT_ENOMEM;
-    size_t need = w->voxel_count + n, cap = w->voxel_cap;
-    void *v = w->voxels;
-    if (grow(&v, &cap, need, sizeof(uint32_t)) != 0)
+    size_t need = w->voxel_count + n;
+    void *v = w->voxels, *s = w->surfaces;
+    if (!shell && grow(&v, &w->voxel_cap, need, sizeof(uint32_t)) != 0)
         return OCT_ENOMEM;
     w->voxels = v;
-    if (w->p.surface_count > 1 && cap != w->voxel_cap) {
-        uint8_t *s = oct__realloc(w->surfaces, cap);
-        if (!s)
-            return OCT_ENOMEM; /* voxel_cap unchanged: the next call retries */
-        w->surfaces = s;
-    }
-    w->voxel_cap = cap;
+    if (w->p.surface_count > 1 && grow(&s, &w->surface_cap, need, 1) != 0)
+        return OCT_ENOMEM; /* voxel_count unchanged: the next call retries */
+    w->surfaces = s;
     if (n) {
-        memcpy(w->voxels + w->voxel_count, voxels, n * sizeof *voxels);
+        if (!shell)
+            memcpy(w->voxels + w->voxel_count, voxels, n * sizeof *voxels);
         if (w->p.surface_count > 1)
             memcpy(w->surfaces + w->voxel_count, surfaces, n);
     }
@@ -209,24 +241,29 @@ static int put_section(const oct_writer *w, int k, sink *s)
         return 0;
     case OCT_SEC_NODES:
         return put_nodes(w, s);
-    case OCT_SEC_VOXELS:
-        return put(s, w->voxels, w->voxel_count * sizeof(uint32_t)); /* little-endian host */
+    case OCT_SEC_VOXELS: /* little-endian host; nothing with OCT_FLAG_SHELL_ONLY */
+        return w->voxels ? put(s, w->voxels, w->voxel_count * sizeof(uint32_t)) : 0;
     case OCT_SEC_SURFACES:
         return w->p.surface_count > 1 ? put(s, w->surfaces, w->voxel_count) : 0;
-    default:
+    case OCT_SEC_PALETTE:
         return put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
+    default:
+        return w->function ? put(s, w->function, w->p.function_size) : 0;
     }
 }
 
-static void build_header(const oct_writer *w, const layout *lay, unsigned char *h)
+/* The header (hsize bytes: 256 for 1.0, 320 for 1.1) into h. */
+static void build_header(const oct_writer *w, const layout *lay, unsigned char *h, uint32_t hsize)
 {
     const oct_writer_params *p = &w->p;
-    memset(h, 0, OCT_HEADER_SIZE);
+    const int nsec = w->v11 ? OCT_SEC_COUNT : OCT_SEC_COUNT_1_0;
+    memset(h, 0, hsize);
     memcpy(h + OCT_OFF_MAGIC, OCT_MAGIC, OCT_MAGIC_SIZE);
     wr_u16le(h + OCT_OFF_MAJOR, OCT_VERSION_MAJOR);
-    wr_u16le(h + OCT_OFF_MINOR, OCT_VERSION_MINOR);
-    wr_u32le(h + OCT_OFF_HEADER_SIZE, OCT_HEADER_SIZE);
+    wr_u16le(h + OCT_OFF_MINOR, w->v11 ? 1 : 0);
+    wr_u32le(h + OCT_OFF_HEADER_SIZE, hsize);
     wr_u32le(h + OCT_OFF_BOM_U32, OCT_BOM_U32);
+    wr_u32le(h + OCT_OFF_FLAGS, p->flags);
     wr_f64le(h + OCT_OFF_BOM_F64, OCT_BOM_F64);
     wr_u32le(h + OCT_OFF_LEVELS, p->levels);
     wr_u32le(h + OCT_OFF_ROOT_DEPTH, p->root_depth);
@@ -239,12 +276,20 @@ static void build_header(const oct_writer *w, const layout *lay, unsigned char *
     wr_f64le(h + OCT_OFF_GRID_EDGE, ldexp(p->edge, (int)p->root_depth));
     wr_u32le(h + OCT_OFF_SURFACE_COUNT, p->surface_count);
     wr_u64le(h + OCT_OFF_VOXEL_COUNT, w->voxel_count);
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+    for (int k = 0; k < nsec; k++) {
         wr_u64le(h + OCT_SEC_OFF(k), lay->off[k]);
         wr_u64le(h + OCT_SEC_OFF(k) + 8, lay->size[k]);
         wr_u32le(h + OCT_SEC_OFF(k) + 16, lay->crc[k]);
     }
-    wr_u32le(h + OCT_OFF_HEADER_CRC, (uint32_t)crc32_z(0, h, OCT_OFF_HEADER_CRC));
+    if (w->v11) {
+        wr_u32le(h + OCT_OFF_SHARD_COUNT, p->shard_count);
+        wr_u32le(h + OCT_OFF_SHARD_INDEX, p->shard_index);
+        wr_u32le(h + OCT_OFF_SHARD_DEPTH, p->shard_depth);
+        wr_u32le(h + OCT_OFF_PARTITION_CRC, p->partition_crc);
+        wr_u64le(h + OCT_OFF_MORTON_LO, p->morton_lo);
+        wr_u64le(h + OCT_OFF_MORTON_HI, p->morton_hi);
+    }
+    wr_u32le(h + hsize - 4, (uint32_t)crc32_z(0, h, hsize - 4));
 }
 
 oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written)
@@ -270,8 +315,10 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
         return OCT_EUSAGE;
 
     layout lay = {0};
-    uint64_t end = OCT_HEADER_SIZE;
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+    const uint32_t hsize = w->v11 ? OCT_HEADER_SIZE_1_1 : OCT_HEADER_SIZE;
+    const int nsec = w->v11 ? OCT_SEC_COUNT : OCT_SEC_COUNT_1_0;
+    uint64_t end = hsize;
+    for (int k = 0; k < nsec; k++) {
         uint64_t size;
         switch (k) {
         case OCT_SEC_LEVELS: size = 8u * L; break;
@@ -280,9 +327,10 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             for (uint32_t d = 0; d < L; d++)
                 size += 16 * groups_of(w->count[d]);
             break;
-        case OCT_SEC_VOXELS: size = 4 * (uint64_t)w->voxel_count; break;
+        case OCT_SEC_VOXELS: size = w->voxels ? 4 * (uint64_t)w->voxel_count : 0; break;
         case OCT_SEC_SURFACES: size = w->p.surface_count > 1 ? w->voxel_count : 0; break;
-        default: size = 12u * w->p.surface_count; break;
+        case OCT_SEC_PALETTE: size = 12u * w->p.surface_count; break;
+        default: size = w->function ? w->p.function_size : 0; break;
         }
         lay.size[k] = size;
         if (size) {
@@ -295,13 +343,13 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
     }
     lay.file_size = end;
 
-    unsigned char h[OCT_HEADER_SIZE];
-    build_header(w, &lay, h);
+    unsigned char h[OCT_HEADER_SIZE_1_1];
+    build_header(w, &lay, h, hsize);
     sink s = {f, 0, 0};
     errno = 0;
-    if (put(&s, h, sizeof h) != 0)
+    if (put(&s, h, hsize) != 0)
         return OCT_EIO;
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+    for (int k = 0; k < nsec; k++) {
         if (lay.size[k] == 0)
             continue;
         if (pad_to(&s, lay.off[k]) != 0 || put_section(w, k, &s) != 0)
@@ -325,5 +373,6 @@ void oct_writer_free(oct_writer *w)
         free(w->masks[d]);
     free(w->voxels);
     free(w->surfaces);
+    free(w->function);
     free(w);
 }

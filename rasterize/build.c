@@ -139,42 +139,57 @@ void build_writer_params(const scene *sc, unsigned levels, float palette[3 * OCT
     wp->palette = palette;
 }
 
+int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p)
+{
+    memset(c, 0, sizeof *c);
+    c->sc = sc;
+    c->par = p;
+    c->shard = p->shard;
+    c->levels = p->levels;
+    c->nsurf = (unsigned)sc->nsurfaces;
+    c->task_depth = p->levels - 1 < TASK_DEPTH ? p->levels - 1 : TASK_DEPTH;
+    build_cube(sc, c->origin, &c->edge);
+    for (int k = 0; k < 3; k++)
+        c->bmax[k] = sc->hi[k];
+    for (unsigned d = 0; d <= c->levels; d++)
+        c->cell_edge[d] = ldexp(c->edge, -(int)d);
+    c->full = calloc(c->nsurf, sizeof *c->full);
+    c->tape_off = calloc(c->nsurf, sizeof *c->tape_off);
+    c->konst_off = calloc(c->nsurf, sizeof *c->konst_off);
+    if (!c->full || !c->tape_off || !c->konst_off)
+        return -1;
+    for (unsigned s = 0; s < c->nsurf; s++) {
+        c->full[s] = &sc->surfaces[s].tape;
+        c->tape_off[s] = c->tape_total;
+        c->tape_total += c->full[s]->n;
+        if (c->full[s]->n > c->max_len)
+            c->max_len = c->full[s]->n;
+        c->konst_off[s] = c->konst_total;
+        c->konst_total += c->full[s]->nconst + c->full[s]->n;
+    }
+    return 0;
+}
+
+void build_ctx_free(build_ctx *c)
+{
+    free(c->full);
+    free(c->tape_off);
+    free(c->konst_off);
+    memset(c, 0, sizeof *c);
+}
+
 oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats)
 {
     memset(stats, 0, sizeof *stats);
     build_ctx c;
-    memset(&c, 0, sizeof c);
-    c.sc = sc;
-    c.par = p;
-    c.levels = p->levels;
-    c.nsurf = (unsigned)sc->nsurfaces;
-    c.task_depth = p->levels - 1 < TASK_DEPTH ? p->levels - 1 : TASK_DEPTH;
-    build_cube(sc, c.origin, &c.edge);
-    for (int k = 0; k < 3; k++)
-        c.bmax[k] = sc->hi[k];
-    for (unsigned d = 0; d <= c.levels; d++)
-        c.cell_edge[d] = ldexp(c.edge, -(int)d);
-
     oct_err err = OCT_ENOMEM;
     pool pl;
     memset(&pl, 0, sizeof pl);
     uint8_t *nonempty = NULL;
     pthread_t *th = NULL;
     unsigned started = 0;
-    c.full = calloc(c.nsurf, sizeof *c.full);
-    c.tape_off = calloc(c.nsurf, sizeof *c.tape_off);
-    c.konst_off = calloc(c.nsurf, sizeof *c.konst_off);
-    if (!c.full || !c.tape_off || !c.konst_off)
+    if (build_ctx_init(&c, sc, p) != 0)
         goto done;
-    for (unsigned s = 0; s < c.nsurf; s++) {
-        c.full[s] = &sc->surfaces[s].tape;
-        c.tape_off[s] = c.tape_total;
-        c.tape_total += c.full[s]->n;
-        if (c.full[s]->n > c.max_len)
-            c.max_len = c.full[s]->n;
-        c.konst_off[s] = c.konst_total;
-        c.konst_total += c.full[s]->nconst + c.full[s]->n;
-    }
 
     pl.c = &c;
     pl.ntasks = (uint64_t)1 << (3 * c.task_depth);
@@ -233,8 +248,6 @@ done:
     free(th);
     free(nonempty);
     free(pl.tasks);
-    free(c.full);
-    free(c.tape_off);
-    free(c.konst_off);
+    build_ctx_free(&c);
     return err;
 }

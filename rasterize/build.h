@@ -14,6 +14,15 @@ typedef enum build_method {
     BUILD_LIPSCHITZ  /* drop a cell when |f(centre)| exceeds the gradient bound times its half-size */
 } build_method;
 
+/* The piece of the grid one shard builds (rasterize --shard, shard.h): the
+ * voxels whose depth-`depth` ancestor has a Morton code in [lo, hi). The
+ * decisions for a cell do not depend on the range, so N shards together
+ * hold exactly the whole tree. */
+typedef struct build_shard {
+    uint32_t count, index, depth, crc; /* crc: of the partition's count + 1 boundaries */
+    uint64_t lo, hi;
+} build_shard;
+
 typedef struct build_params {
     unsigned levels;     /* 1..OCT_MAX_LEVELS */
     build_method method;
@@ -22,6 +31,8 @@ typedef struct build_params {
      * may be NULL. */
     void (*progress)(void *ctx, double fraction);
     void *progress_ctx;
+    int shell_only;      /* --shell-only: voxels without records (no normals, no Newton steps) */
+    const build_shard *shard; /* NULL: the whole grid */
 } build_params;
 
 /* What the build did, for the summary and the benchmark. */
@@ -46,7 +57,7 @@ void build_cube(const scene *sc, double origin[3], double *edge);
 void build_writer_params(const scene *sc, unsigned levels, float palette[3 * OCT_MAX_SURFACES],
                          oct_writer_params *wp);
 
-/* Runs the whole subdivision and appends every node and voxel to `w`
+/* Runs the subdivision (of the whole grid, or of p->shard's piece) and appends every node and voxel to `w`
  * (created by the caller with the same levels and cube). Returns OCT_OK,
  * OCT_ENOMEM, or the writer's error. *stats is filled in either way. */
 oct_err build_octree(const scene *sc, const build_params *p, oct_writer *w, build_stats *stats);

@@ -63,7 +63,44 @@ typedef struct build_ctx {
     uint32_t *konst_off;       /* offset of each surface's pruned constant pool */
     uint32_t konst_total;      /* sum of (constants + instructions) over the surfaces */
     uint32_t max_len;
+    const build_shard *shard;  /* NULL: the whole grid */
 } build_ctx;
+
+/* build.c: the context of a build with parameters p (p->levels, method,
+ * shard; threads unused); -1 when memory runs out. build_ctx_free releases
+ * it, also after a failed build_ctx_init. */
+int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p);
+void build_ctx_free(build_ctx *c);
+
+/* The Morton code of a cell at depth (its coordinates' bits interleaved,
+ * x lowest). */
+static inline uint64_t morton_encode(const uint64_t cell[3], unsigned depth)
+{
+    uint64_t m = 0;
+    for (unsigned b = 0; b < depth; b++)
+        m |= ((cell[0] >> b) & 1) << (3 * b) | ((cell[1] >> b) & 1) << (3 * b + 1) |
+             ((cell[2] >> b) & 1) << (3 * b + 2);
+    return m;
+}
+
+/* Whether the cell (depth, cell) holds part of the shard's piece: a cell at
+ * or above the shard depth when its descendants there meet [lo, hi), a
+ * deeper one when its ancestor there lies in it. Always 1 without a shard. */
+static inline int shard_meets(const build_ctx *c, unsigned depth, const uint64_t cell[3])
+{
+    const build_shard *sh = c->shard;
+    if (!sh)
+        return 1;
+    uint64_t m = morton_encode(cell, depth), first, end;
+    if (depth <= sh->depth) {
+        first = m << (3 * (sh->depth - depth));
+        end = (m + 1) << (3 * (sh->depth - depth));
+    } else {
+        first = m >> (3 * (depth - sh->depth));
+        end = first + 1;
+    }
+    return first < sh->hi && end > sh->lo;
+}
 
 /* What one task produced: the subtree below one depth-S cell. */
 typedef struct task_out {
@@ -160,6 +197,10 @@ static inline const double *centre_fg(worker *wk, unsigned s, const double centr
  * one nearest its centre by the first-order distance |f| / |grad f|. Starts
  * its Newton iteration and forgets the centre values (wk->cf). */
 unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw);
+
+/* --shell-only: the voxel's surface without a record (no normal, no Newton
+ * steps); forgets the centre values as voxel_surface does. */
+unsigned shell_surface(worker *wk, unsigned idx, const double centre[3]);
 
 /* Appends the voxel's record (lists at index levels + 1). 0 when memory
  * runs out (then wk->failed is set). */

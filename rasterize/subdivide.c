@@ -118,7 +118,8 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
             continue;
         if (retest) { /* records made below, all together */
             child[np] = (uint8_t)i;
-            surf[np] = (uint8_t)voxel_surface(wk, cidx, centre, &nw[np]);
+            surf[np] = (uint8_t)(c->par->shell_only ? shell_surface(wk, cidx, centre) /* --shell-only */
+                                                    : voxel_surface(wk, cidx, centre, &nw[np]));
             np++;
             mask |= (uint8_t)(1u << i);
         } else if (depth + 1 == c->levels) {
@@ -149,7 +150,8 @@ static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
                               2 * cell[2] + (i >> 2)};
             interval box[3];
             double centre[3];
-            if (!cell_test_surviving(wk, depth + 1, depth + 1, cc, box, centre))
+            if (!shard_meets(c, depth + 1, cc) || /* outside this shard's piece */
+                !cell_test_surviving(wk, depth + 1, depth + 1, cc, box, centre))
                 continue;
             if (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc))
                 mask |= (uint8_t)(1u << i);
@@ -183,6 +185,6 @@ void run_task(worker *wk, uint64_t task, task_out *out)
     wk->out = out;
     interval box[3];
     double centre[3];
-    if (cell_test_surviving(wk, 0, c->task_depth, cell, box, centre))
+    if (shard_meets(c, c->task_depth, cell) && cell_test_surviving(wk, 0, c->task_depth, cell, box, centre))
         out->nonempty = visit_node(wk, c->task_depth, cell) != 0;
 }

@@ -123,10 +123,22 @@ static int push_voxel(worker *wk, uint32_t rec, unsigned surface)
     return 1;
 }
 
+unsigned shell_surface(worker *wk, unsigned idx, const double centre[3])
+{
+    newton nw;
+    if (wk->nact[idx] > 1)
+        return voxel_surface(wk, idx, centre, &nw);
+    unsigned s = wk->act[(size_t)idx * wk->c->nsurf];
+    wk->cf_ok[s] = 0;
+    return s;
+}
+
 int emit_voxel(worker *wk, const interval box[3], const double centre[3])
 {
     const build_ctx *c = wk->c;
     unsigned idx = c->levels + 1;
+    if (c->par->shell_only) /* --shell-only: the writer stores no record */
+        return push_voxel(wk, 0, shell_surface(wk, idx, centre));
     newton nw;
     unsigned best = voxel_surface(wk, idx, centre, &nw);
     const tape *t = c->full[best];
@@ -144,6 +156,11 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
     const build_ctx *c = wk->c;
     double h = c->cell_edge[c->levels];
     uint8_t live[8];
+    if (c->par->shell_only) { /* --shell-only: the writer stores no record */
+        for (unsigned j = 0; j < np && !wk->failed; j++)
+            push_voxel(wk, 0, surf[j]);
+        return;
+    }
     for (unsigned j = 0; j < np; j++)
         live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
     for (;;) {

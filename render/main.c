@@ -24,13 +24,15 @@
 #include "render/trace.h"
 #include "render/views.h"
 
+#define RENDER_MAX_PARTS 100000 /* --part I/N: N at most the largest --orbit */
+
 static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
     "              [--split K] [--refine] [--light X,Y,Z] [--background R,G,B]\n"
     "              [--beam N] [--threads N] [--trust] [--info] [-q]\n"
-    "       render FILE.oct --views VIEWS_FILE [options]\n"
-    "       render FILE.oct -o 'frame_%04d.png' --orbit N [options]\n"
+    "       render FILE.oct --views VIEWS_FILE [--part I/N] [options]\n"
+    "       render FILE.oct -o 'frame_%04d.png' --orbit N [--part I/N] [options]\n"
     "       render --info FILE.oct\n";
 
 static const char help_text[] =
@@ -56,9 +58,12 @@ static const char help_text[] =
     "  --views FILE        one view a line, same options as above ('#' comments)\n"
     "  --orbit N           N views on a circle around the target; -o is a pattern\n"
     "                      with one integer conversion, e.g. frame_%04d.png\n"
+    "  --part I/N          render only views I, I+N, I+2N, ... of --views or --orbit\n"
+    "                      (0 <= I < N <= " LIMIT_STR(RENDER_MAX_PARTS) "): N parts write the frames of one run\n"
     "  --trust             skip the file's CRC-32 checks (a fixed cost per file); the\n"
     "                      structure is still validated in full\n"
-    "  --info              print a summary of FILE.oct\n"
+    "  --info              print a summary of FILE.oct (format version, flags,\n"
+    "                      tree, stored function, shard fields)\n"
     "  -q                  no per-view timing lines\n"
     "  --version           print the version and exit\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
@@ -116,6 +121,7 @@ typedef struct render_args {
     views_view base; /* the command line's view options */
     const char *oct_path, *views_path;
     long orbit, split, threads, beam;
+    long part_index, part_count; /* --part I/N; count 0: every view */
     int refine, info, quiet, trust;
     double light[3], bg[3];
     int has_light;
@@ -134,6 +140,8 @@ static int parse_value_option(render_args *o, const char *a, const char *val)
         o->views_path = val;
     } else if (strcmp(a, "--orbit") == 0) {
         e = parse_long(val, 1, 100000, &o->orbit);
+    } else if (strcmp(a, "--part") == 0) {
+        e = parse_index_of(val, RENDER_MAX_PARTS, &o->part_index, &o->part_count);
     } else if (strcmp(a, "--split") == 0) {
         e = parse_long(val, 0, OCT_MAX_LEVELS, &o->split);
     } else if (strcmp(a, "--threads") == 0) {
@@ -174,6 +182,8 @@ static int check_args(const render_args *o)
     if (pattern != 0)
         return diag_usage_error(usage_text, "--orbit: -o '%s': %s", o->base.out,
                                 views_orbit_strerror(pattern == -2 ? VIEWS_ORBIT_WIDTH : VIEWS_ORBIT_PATTERN));
+    if (o->part_count && !o->views_path && !o->orbit)
+        return diag_usage_error(usage_text, "%s", "--part needs --views or --orbit");
     if (o->orbit && (o->base.depth || o->base.normals))
         return diag_usage_error(usage_text, "%s", "--orbit writes colour images only (no --depth or --normals)");
     return -1;
@@ -215,7 +225,7 @@ static int parse_args(int argc, char **argv, render_args *o)
             continue;
         }
         int known = views_is_option(a) || strcmp(a, "--views") == 0 ||
-                    strcmp(a, "--orbit") == 0 || strcmp(a, "--split") == 0 ||
+                    strcmp(a, "--orbit") == 0 || strcmp(a, "--split") == 0 || strcmp(a, "--part") == 0 ||
                     strcmp(a, "--light") == 0 || strcmp(a, "--background") == 0 ||
                     strcmp(a, "--threads") == 0 || strcmp(a, "--beam") == 0;
         if (!known)
@@ -265,14 +275,14 @@ static int load_views_file(const render_args *o, const views_view *base, char **
  * or the exit status. */
 static int open_tree(const render_args *o, oct_file **file)
 {
-    uint64_t off = 0;
-    oct_err err = oct_open(o->oct_path, o->trust ? OCT_OPEN_TRUST : 0u, file, &off);
+    oct_fault fault;
+    oct_err err = oct_open_fault(o->oct_path, o->trust ? OCT_OPEN_TRUST : 0u, file, &fault);
     if (err != OCT_OK) {
         if (err == OCT_EIO)
             diag_path_error(o->oct_path, "%s", strerror(errno));
-        else if (off)
-            diag_path_error(o->oct_path, "corrupt: %s at offset %llu", oct_strerror(err),
-                            (unsigned long long)off);
+        else if (fault.offset) /* what: the broken rule, without "corrupt: " */
+            diag_path_error(o->oct_path, "corrupt: %s at offset %llu", fault.what,
+                            (unsigned long long)fault.offset);
         else
             diag_path_error(o->oct_path, "%s", oct_strerror(err));
         return EXIT_RUNTIME;
@@ -415,20 +425,26 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     return EXIT_OK;
 }
 
-/* The view loop: every view in turn, then the totals line. */
+/* The view loop: every view in turn (with --part I/N, views I, I+N, ...),
+ * then the totals line. */
 static int render_views(const oct_tree *tree, const render_args *o, const views_view *list,
                         size_t nviews, const camera *cams, const render_buffers *buf)
 {
     double total_ms = 0.0;
     uint64_t total_rays = 0;
-    for (size_t k = 0; k < nviews; k++) {
+    size_t first = o->part_count ? (size_t)o->part_index : 0, step = o->part_count ? (size_t)o->part_count : 1;
+    size_t done = 0;
+    for (size_t k = first; k < nviews; k += step, done++) {
         int st = render_view(tree, o, &list[k], &cams[k], buf, &total_ms, &total_rays);
         if (st != EXIT_OK)
             return st;
     }
+    if (!o->quiet && o->part_count)
+        fprintf(stderr, "render: part %ld/%ld: %zu of %zu views\n", o->part_index, o->part_count, done,
+                nviews);
     if (!o->quiet)
         fprintf(stderr, "render: %zu view%s, %.2f Mrays in %.1f ms, %.2f Mrays/s, %ld thread%s\n",
-                nviews, nviews == 1 ? "" : "s", (double)total_rays / 1e6, total_ms,
+                done, done == 1 ? "" : "s", (double)total_rays / 1e6, total_ms,
                 total_ms > 0 ? (double)total_rays / total_ms / 1e3 : 0.0, o->threads,
                 o->threads == 1 ? "" : "s");
     return EXIT_OK;
@@ -456,6 +472,11 @@ static int run(int argc, char **argv)
         status = open_tree(&o, &file);
     if (status != EXIT_OK || (!o.views_path && !o.base.out))
         goto done; /* an error, or --info only */
+    if (oct_get_info(file)->flags & OCT_FLAG_SHELL_ONLY) { /* only the function can place hits */
+        diag_path_error(o.oct_path, "stores no normals (rasterized with --shell-only): use --exact");
+        status = EXIT_RUNTIME;
+        goto done;
+    }
     const oct_tree *tree = oct_get_tree(file);
     if (o.split > (long)tree->levels) {
         char msg[512];

@@ -15,6 +15,14 @@ if [ "${1:-build}" = test ]; then
     [ -f /usr/include/mpfr.h ]             || need="$need libmpfr-dev"  # interval tests check against MPFR
     command -v groff >/dev/null            || need="$need groff"        # install.sh formats the man pages
 fi
+
+# farm/: the engines tests/cli/farm_*.sh run (GNU parallel; a local Slurm cluster)
+if [ "${1:-build}" = test ]; then
+    command -v parallel >/dev/null                       || need="$need parallel"
+    command -v slurmctld >/dev/null && command -v slurmd >/dev/null || need="$need slurm-wlm"
+    command -v munged >/dev/null                         || need="$need munge"
+fi
+
 [ -z "$need" ] && exit 0
 if ! command -v apt-get >/dev/null; then
     echo "deps: missing:$need; install them with your package manager" >&2

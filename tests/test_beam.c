@@ -12,6 +12,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "bench/rng.h"
 #include "common/view/camera.h"
 #include "render/beam.h"
 #include "render/trace.h"
@@ -20,10 +21,7 @@ static uint64_t rng_state = 0x2545f4914f6cdd1dULL;
 
 static double urand(void) /* [0, 1) */
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) * 0x1p-53;
+    return rng_unit(rng_xorshift64(&rng_state));
 }
 
 static double srand1(void) { return 2.0 * urand() - 1.0; } /* [-1, 1) */

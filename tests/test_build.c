@@ -42,7 +42,7 @@ static void build_in_memory(const scene *sc, unsigned levels, build_method metho
     build_writer_params(sc, levels, palette, &wp);
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {levels, method, threads, NULL, NULL};
+    build_params bp = {.levels = levels, .method = method, .threads = threads};
     assert_int_equal(build_octree(sc, &bp, w, &b->st), OCT_OK);
     FILE *mem = open_memstream(&b->bytes, &b->size);
     assert_non_null(mem);

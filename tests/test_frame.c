@@ -15,6 +15,7 @@
 #include "common/view/image.h"
 #include "format/oct_normal.h"
 #include "render/frame.h"
+#include "bench/rng.h"
 #include "bench/tree_util.h"
 
 static oct_tree *ball(unsigned levels)
@@ -316,10 +317,7 @@ static uint64_t skew_rng = 88172645463325252ULL;
 
 static double skew_rand(void) /* [-1, 1) */
 {
-    skew_rng ^= skew_rng << 13;
-    skew_rng ^= skew_rng >> 7;
-    skew_rng ^= skew_rng << 17;
-    return (double)(skew_rng >> 11) * 0x1p-53 * 2.0 - 1.0;
+    return rng_unit(rng_xorshift64(&skew_rng)) * 2.0 - 1.0;
 }
 
 static void test_beam_skewed_camera(void **state)

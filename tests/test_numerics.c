@@ -231,7 +231,7 @@ static build_stats rasterize_text(const char *text, unsigned levels, vox_list *v
     wp.palette = palette;
     oct_writer *w = NULL;
     assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {levels, BUILD_INTERVAL, 2, NULL, NULL};
+    build_params bp = {.levels = levels, .method = BUILD_INTERVAL, .threads = 2};
     build_stats st;
     assert_int_equal(build_octree(sc, &bp, w, &st), OCT_OK);
     char *bytes = NULL;

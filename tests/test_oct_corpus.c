@@ -12,6 +12,51 @@
 #include "format/oct.h"
 #include "format/oct_layout.h"
 #include "bench/oct_synth.h"
+#include "tests/oct_fn_util.h"
+
+static void write_file(const char *dir, const char *name, const unsigned char *buf, size_t len)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(buf, 1, len, f), len);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* Format 1.1 seeds: a function, shell-only, a shard, and a function with an
+ * unknown op code (CRCs fixed, so it reaches check 13a). */
+static void make_1_1_seeds(const char *dir)
+{
+    test_tree t;
+    unsigned char *buf;
+    size_t len;
+    test_fn_small_file(&buf, &len, &t, 0);
+    write_file(dir, "ok-v11-function.oct", buf, len);
+    uint64_t F = rd_u64le(buf + OCT_SEC_OFF(OCT_SEC_FUNCTION));
+    uint64_t ins = F + OCT_FN_HEAD + OCT_FN_TAPE_HEAD + 24ull * rd_u32le(buf + F + OCT_FN_HEAD + 4);
+    wr_u32le(buf + ins, OCT_OP_COUNT);
+    test_oct_refresh_crcs(buf, len);
+    write_file(dir, "bad-v11-op.oct", buf, len);
+    free(buf);
+    test_tree_free(&t);
+    test_fn_small_file(&buf, &len, &t, OCT_FLAG_SHELL_ONLY);
+    write_file(dir, "ok-v11-shell.oct", buf, len);
+    free(buf);
+    test_tree_free(&t);
+    test_tree_random(&t, 4, 100, 1, 5, 1);
+    oct_writer_params p = {0};
+    p.shard_count = 8;
+    p.shard_index = 2;
+    p.shard_depth = 2;
+    p.partition_crc = 0xdeadbeefu;
+    p.morton_lo = 16;
+    p.morton_hi = 24;
+    assert_int_equal(test_tree_write_1_1(&t, &p, &buf, &len), OCT_OK);
+    write_file(dir, "ok-v11-shard.oct", buf, len);
+    free(buf);
+    test_tree_free(&t);
+}
 
 static void test_make_fuzz_corpus(void **state)
 {
@@ -56,6 +101,7 @@ static void test_make_fuzz_corpus(void **state)
             test_tree_free(&t);
         }
     }
+    make_1_1_seeds(dir);
 }
 
 int main(void)

@@ -299,68 +299,100 @@ static void test_tree_damage(void **state)
     test_tree_free(&t);
 }
 
+/* The small 1.0 file as a newer minor (OCT_VERSION_MINOR + 1) would write
+ * it: a 384-byte header (1.1's fields zero, "new fields" 0xab in 320..379,
+ * garbage in 1.1's reserved bytes) and the sections shifted by 128, plus
+ * `extra` trailing bytes of garbage. */
+static unsigned char *newer_minor_file(const unsigned char *buf, size_t len, size_t extra, size_t *out_len)
+{
+    const size_t shift = 384 - OCT_HEADER_SIZE;
+    *out_len = len + shift + extra;
+    unsigned char *big = calloc(1, *out_len);
+    assert_non_null(big);
+    memcpy(big, buf, OCT_OFF_RESERVED1);
+    memcpy(big + 384, buf + OCT_HEADER_SIZE, len - OCT_HEADER_SIZE);
+    memset(big + len + shift, 0x5a, extra);
+    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR + 1);
+    wr_u32le(big + OCT_OFF_HEADER_SIZE, 384);
+    for (int k = 0; k < OCT_SEC_COUNT; k++) {
+        uint64_t off = rd_u64le(big + OCT_SEC_OFF(k));
+        if (off)
+            wr_u64le(big + OCT_SEC_OFF(k), off + shift);
+    }
+    big[OCT_OFF_RESERVED2 + 3] = 7;            /* reserved in 1.1: ignored */
+    big[OCT_SEC_OFF(OCT_SEC_FUNCTION) + 21] = 7; /* an entry's reserved field: ignored */
+    memset(big + 320, 0xab, 60);               /* fields 1.1 does not know */
+    test_oct_refresh_crcs(big, *out_len);      /* header CRC at 380 */
+    return big;
+}
+
 static void test_trailing_bytes_and_versions(void **state)
 {
     (void)state;
     test_tree t;
     unsigned char *buf;
-    size_t len;
+    size_t len, big_len;
     oct_check_small_file(&buf, &len, &t);
     unsigned char *big = calloc(1, len + 64);
     memcpy(big, buf, len);
     assert_int_equal(oct_check_open(big, len + 1, 0, NULL), OCT_ESECTION); /* trailing garbage */
+    free(big);
     /* A newer minor: accepted, and its trailing data and reserved bytes ignored. */
-    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR + 1);
-    big[OCT_OFF_RESERVED1] = 7;
-    test_oct_refresh_crcs(big, len);
+    big = newer_minor_file(buf, len, 64, &big_len);
     oct_file *f;
-    assert_int_equal(oct_open_memory(big, len + 64, 0, &f, NULL), OCT_OK);
+    assert_int_equal(oct_open_memory(big, big_len, 0, &f, NULL), OCT_OK);
     assert_int_equal(oct_get_info(f)->version_minor, OCT_VERSION_MINOR + 1);
     oct_check_tree(f, &t);
     oct_close(f);
+    /* ... but not an unknown flag: every flag is required. */
+    wr_u32le(big + OCT_OFF_FLAGS, 2);
+    test_oct_refresh_crcs(big, big_len);
+    uint64_t at;
+    assert_int_equal(oct_check_open(big, big_len, 0, &at), OCT_EHEADER);
+    assert_int_equal(at, OCT_OFF_FLAGS);
     /* A newer major: refused before anything else is looked at. */
     wr_u16le(big + OCT_OFF_MAJOR, OCT_VERSION_MAJOR + 1);
     wr_u32le(big + OCT_OFF_LEVELS, 99);
-    assert_int_equal(oct_check_open(big, len, 0, NULL), OCT_EVERSION);
+    assert_int_equal(oct_check_open(big, big_len, 0, NULL), OCT_EVERSION);
     free(big);
     free(buf);
     test_tree_free(&t);
 }
 
-/* A newer minor with a 320-byte header (new fields in it, sections shifted
- * by 64) opens; the same layout claiming minor 0 is refused. */
+/* A newer minor's longer header (new fields in it, sections shifted) opens;
+ * its new bytes are under the header CRC; the same layout claiming minor 1
+ * (header 320) or minor 0 (header 256) is refused, and so is a newer minor
+ * with a header shorter than 1.1's. */
 static void test_newer_minor_longer_header(void **state)
 {
     (void)state;
     test_tree t;
     unsigned char *buf;
-    size_t len;
+    size_t len, big_len;
     oct_check_small_file(&buf, &len, &t);
-    size_t big_len = len + 64;
-    unsigned char *big = calloc(1, big_len);
-    memcpy(big, buf, OCT_HEADER_SIZE);
-    memcpy(big + 320, buf + OCT_HEADER_SIZE, len - OCT_HEADER_SIZE);
-    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR + 1);
-    wr_u32le(big + OCT_OFF_HEADER_SIZE, 320);
-    memset(big + OCT_OFF_HEADER_CRC, 0xab, 64); /* "new fields" where 1.0 had its CRC */
-    for (int k = 0; k < OCT_SEC_COUNT; k++) {
-        uint64_t off = rd_u64le(big + OCT_SEC_OFF(k));
-        if (off)
-            wr_u64le(big + OCT_SEC_OFF(k), off + 64);
-    }
-    test_oct_refresh_crcs(big, big_len); /* header CRC at 316 */
+    unsigned char *big = newer_minor_file(buf, len, 0, &big_len);
     oct_file *f;
     assert_int_equal(oct_open_memory(big, big_len, 0, &f, NULL), OCT_OK);
     oct_check_tree(f, &t);
     oct_close(f);
-    big[0x130] ^= 1; /* the new header bytes are covered by the header CRC */
+    big[0x150] ^= 1; /* the new header bytes are covered by the header CRC */
     uint64_t at;
     assert_int_equal(oct_check_open(big, big_len, 0, &at), OCT_ECRC);
-    assert_int_equal(at, 316);
-    big[0x130] ^= 1;
-    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR);
-    test_oct_refresh_crcs(big, big_len);
-    assert_int_equal(oct_check_open(big, big_len, 0, &at), OCT_EHEADER);
+    assert_int_equal(at, 380);
+    big[0x150] ^= 1;
+    for (unsigned minor = 0; minor <= OCT_VERSION_MINOR; minor++) {
+        wr_u16le(big + OCT_OFF_MINOR, (uint16_t)minor);
+        test_oct_refresh_crcs(big, big_len);
+        assert_int_equal(oct_check_open(big, big_len, 0, &at), OCT_EHEADER);
+        assert_int_equal(at, OCT_OFF_HEADER_SIZE);
+    }
+    free(big);
+    /* the 1.0 file relabelled minor 2: a 256-byte header is too short */
+    big = malloc(len);
+    memcpy(big, buf, len);
+    wr_u16le(big + OCT_OFF_MINOR, OCT_VERSION_MINOR + 1);
+    test_oct_refresh_crcs(big, len);
+    assert_int_equal(oct_check_open(big, len, 0, &at), OCT_EHEADER);
     assert_int_equal(at, OCT_OFF_HEADER_SIZE);
     free(big);
     free(buf);

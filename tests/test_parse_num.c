@@ -82,6 +82,31 @@ static void test_vec3_and_size(void **state)
     assert_int_equal(parse_size("64x", 32768, &w, &h), PARSE_SYNTAX);
 }
 
+static void test_index_of(void **state)
+{
+    (void)state;
+    long i = -5, n = -5;
+    assert_int_equal(parse_index_of("0/1", 64, &i, &n), PARSE_OK);
+    assert_int_equal(i, 0);
+    assert_int_equal(n, 1);
+    assert_int_equal(parse_index_of("6/7", 64, &i, &n), PARSE_OK);
+    assert_int_equal(i, 6);
+    assert_int_equal(n, 7);
+    i = n = -5;
+    assert_int_equal(parse_index_of("3/3", 64, &i, &n), PARSE_RANGE);
+    assert_int_equal(parse_index_of("-1/4", 64, &i, &n), PARSE_RANGE);
+    assert_int_equal(parse_index_of("0/0", 64, &i, &n), PARSE_RANGE);
+    assert_int_equal(parse_index_of("0/65", 64, &i, &n), PARSE_RANGE);
+    assert_int_equal(parse_index_of("x/y", 64, &i, &n), PARSE_SYNTAX);
+    assert_int_equal(parse_index_of("1", 64, &i, &n), PARSE_SYNTAX);
+    assert_int_equal(parse_index_of("/4", 64, &i, &n), PARSE_SYNTAX);
+    assert_int_equal(parse_index_of("1/", 64, &i, &n), PARSE_SYNTAX);
+    assert_int_equal(parse_index_of("1/2/3", 64, &i, &n), PARSE_SYNTAX);
+    assert_int_equal(parse_index_of("", 64, &i, &n), PARSE_EMPTY);
+    assert_int_equal(i, -5); /* untouched on failure */
+    assert_int_equal(n, -5);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -90,6 +115,7 @@ int main(void)
         cmocka_unit_test(test_float_prefix_reports_dangling_exponent),
         cmocka_unit_test(test_long_range_and_syntax),
         cmocka_unit_test(test_vec3_and_size),
+        cmocka_unit_test(test_index_of),
     };
     return cmocka_run_group_tests_name("parse_num", tests, NULL, NULL);
 }

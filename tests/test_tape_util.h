@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "bench/rng.h"
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
 
@@ -33,14 +34,8 @@
 
 /* One generator per test program (xorshift64, fixed seed). */
 static uint64_t rng = 0x2545f4914f6cdd1dull;
-static inline uint64_t next_u64(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
-}
-static inline double unit(void) { return (double)(next_u64() >> 11) * 0x1p-53; }
+static inline uint64_t next_u64(void) { return rng_xorshift64(&rng); }
+static inline double unit(void) { return rng_unit(next_u64()); }
 
 /* v is enclosed by r (with the flag rules of interval.h). */
 static inline int encloses(interval r, unsigned flags, double v)

@@ -24,7 +24,7 @@ allowed() {
     case "$1:$2" in
         common/expr:common | common/view:common) return 0 ;;
         rasterize:common/expr | rasterize:common | rasterize:format) return 0 ;;
-        render:common/view | render:common | render:format) return 0 ;;
+        render:common/view | render:common/expr | render:common | render:format) return 0 ;;
         bench:render | bench:common/expr | bench:common/view | bench:common | bench:format) return 0 ;;
         tests:bench | tests:render | tests:rasterize | tests:common/expr | tests:common/view \
             | tests:common | tests:format) return 0 ;;
