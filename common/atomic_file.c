@@ -12,13 +12,17 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "common/output_path.h"
+
 struct atomic_file {
     FILE *fp;  /* a cookie stream over fd, so the fault hook sees every write */
     int fd;
     char *target;
     char *tmp;
     char *dir;
-    int registered;
+    int registered; /* in the signal handler's table */
+    int made;       /* the temporary exists */
+    int direct;     /* a device, FIFO or stdout: written in place, no rename */
 };
 
 /* Temporary files alive right now, for the signal handler. A fixed table:
@@ -33,7 +37,40 @@ static void on_signal(int sig)
         if (live[i])
             unlink(live[i]);
     signal(sig, SIG_DFL);
-    raise(sig);
+    raise(sig); /* blocked until the handler returns, then the default kills */
+}
+
+/* Every signal whose default action ends the process, except the faults of
+ * the program itself (SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGTRAP: their
+ * handling belongs to the code that can cause them) and SIGKILL/SIGSTOP,
+ * which cannot be caught. SIGXFSZ is here: a file-size limit kills the
+ * writer in the middle of a write. */
+static const int fatal_signals[] = {
+    SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGPIPE, SIGALRM, SIGUSR1, SIGUSR2, SIGABRT,
+    SIGXCPU, SIGXFSZ, SIGVTALRM, SIGPROF,
+#ifdef SIGIO
+    SIGIO,
+#endif
+#ifdef SIGPWR
+    SIGPWR,
+#endif
+#ifdef SIGSTKFLT
+    SIGSTKFLT,
+#endif
+#ifdef SIGSYS
+    SIGSYS,
+#endif
+};
+
+static void install_one(int sig)
+{
+    struct sigaction sa, old;
+    if (sigaction(sig, NULL, &old) != 0 || old.sa_handler != SIG_DFL)
+        return; /* ignored (nohup and friends) or someone else's handler */
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigfillset(&sa.sa_mask); /* one handler at a time */
+    sigaction(sig, &sa, NULL);
 }
 
 static void install_handlers(void)
@@ -41,17 +78,12 @@ static void install_handlers(void)
     if (handlers_installed)
         return;
     handlers_installed = 1;
-    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
-        struct sigaction sa;
-        memset(&sa, 0, sizeof sa);
-        sa.sa_handler = on_signal;
-        sigemptyset(&sa.sa_mask);
-        struct sigaction old;
-        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
-            continue; /* respect nohup and friends */
-        sigaction(sigs[i], &sa, NULL);
-    }
+    for (size_t i = 0; i < sizeof fatal_signals / sizeof fatal_signals[0]; i++)
+        install_one(fatal_signals[i]);
+#if defined(SIGRTMIN) && defined(SIGRTMAX)
+    for (int sig = SIGRTMIN; sig <= SIGRTMAX; sig++)
+        install_one(sig);
+#endif
 }
 
 static void set_live(atomic_file *af, int on)
@@ -73,6 +105,8 @@ static void set_live(atomic_file *af, int on)
     }
     pthread_sigmask(SIG_SETMASK, &old, NULL);
 }
+
+static void release(atomic_file *af, int remove_tmp);
 
 /* --- fault injection (test hook) -------------------------------------- */
 
@@ -122,16 +156,6 @@ static int fault_check(const char *op)
 
 /* --- public API ------------------------------------------------------- */
 
-static char *dir_of(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        return strdup(".");
-    if (slash == path)
-        return strdup("/");
-    return strndup(path, (size_t)(slash - path));
-}
-
 static ssize_t cookie_write(void *cookie, const char *data, size_t n)
 {
     atomic_file *af = cookie;
@@ -175,40 +199,83 @@ static int cookie_close(void *cookie)
     return close(fd);
 }
 
+static void free_af(atomic_file *af)
+{
+    free(af->target);
+    free(af->tmp);
+    free(af->dir);
+    free(af);
+}
+
+/* The temporary beside the target (af->target resolved already). */
+static int open_temp(atomic_file *af)
+{
+    af->dir = output_path_dir(af->target);
+    af->tmp = output_path_temp_template(af->target);
+    if (!af->dir || !af->tmp) {
+        errno = ENOMEM;
+        return -1;
+    }
+    install_handlers();
+    /* Registered before it exists, so that no signal can leave it behind;
+     * unlinking a name not created yet is harmless. */
+    sigset_t all, old;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &old);
+    int fd = mkstemp(af->tmp);
+    if (fd >= 0) {
+        af->made = 1;
+        set_live(af, 1);
+    }
+    int e = errno;
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (fd < 0) {
+        errno = e;
+        return -1;
+    }
+    mode_t mask = umask(0); /* mkstemp makes 0600; outputs are ordinary files */
+    umask(mask);
+    fchmod(fd, 0666 & ~mask);
+    af->fd = fd;
+    return 0;
+}
+
 atomic_file *atomic_file_open(const char *target_path)
 {
     atomic_file *af = calloc(1, sizeof *af);
     if (!af)
         return NULL;
-    af->target = strdup(target_path);
-    af->dir = dir_of(target_path);
-    size_t n = strlen(target_path) + 16;
-    af->tmp = malloc(n);
-    if (!af->target || !af->dir || !af->tmp) {
-        free(af->target); free(af->dir); free(af->tmp); free(af);
-        errno = ENOMEM;
-        return NULL;
-    }
-    snprintf(af->tmp, n, "%s.tmp.XXXXXX", target_path);
-    install_handlers();
-    int fd = mkstemp(af->tmp);
-    if (fd < 0) {
+    af->fd = -1;
+    output_kind kind;
+    if (output_path_classify(target_path, &kind, &af->target) != 0) {
         int e = errno;
-        free(af->target); free(af->dir); free(af->tmp); free(af);
+        free_af(af);
         errno = e;
         return NULL;
     }
-    set_live(af, 1);
-    mode_t mask = umask(0); /* mkstemp makes 0600; outputs are ordinary files */
-    umask(mask);
-    fchmod(fd, 0666 & ~mask);
-    af->fd = fd;
+    int rc = 0;
+    if (kind == OUTPUT_REPLACE) {
+        rc = open_temp(af);
+    } else {
+        /* Written where it is: replacing a device or a FIFO by a regular
+         * file would be wrong, and renaming over stdout impossible. */
+        af->direct = 1;
+        af->fd = kind == OUTPUT_STDOUT ? dup(STDOUT_FILENO)
+                                       : open(target_path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
+        rc = af->fd < 0 ? -1 : 0;
+    }
+    if (rc != 0) {
+        int e = errno;
+        release(af, 1);
+        errno = e;
+        return NULL;
+    }
     cookie_io_functions_t io = {NULL, cookie_write, cookie_seek, cookie_close};
     af->fp = fopencookie(af, "wb", io);
     if (!af->fp) {
         int e = errno;
-        close(fd);
-        atomic_file_abort(af);
+        close(af->fd);
+        release(af, 1);
         errno = e;
         return NULL;
     }
@@ -226,51 +293,86 @@ int atomic_file_write(atomic_file *af, const void *data, size_t n)
 
 static void release(atomic_file *af, int remove_tmp)
 {
-    if (remove_tmp)
+    if (remove_tmp && af->made)
         unlink(af->tmp);
     if (af->registered)
         set_live(af, 0);
-    free(af->target);
-    free(af->tmp);
-    free(af->dir);
-    free(af);
+    free_af(af);
 }
 
-int atomic_file_commit(atomic_file *af, const char **failed_op)
+/* Everything but the rename: flush, fsync, close. Returns 0, or -1 with
+ * errno and *op naming the step; the stream is closed either way. */
+static int finish(atomic_file *af, const char **op)
 {
-    const char *op = "write";
-    if (fflush(af->fp) != 0 || ferror(af->fp))
-        goto fail;
-    op = "fsync";
-    if (fault_check("fsync") != 0 || fsync(af->fd) != 0)
-        goto fail;
-    op = "close";
+    *op = "write";
+    int rc = fflush(af->fp) != 0 || ferror(af->fp) ? -1 : 0;
+    /* Devices and FIFOs have nothing to make durable (fsync would say
+     * EINVAL); a regular file must be on disk before it is renamed. */
+    if (rc == 0 && !af->direct) {
+        *op = "fsync";
+        rc = fault_check("fsync") != 0 || fsync(af->fd) != 0 ? -1 : 0;
+    }
+    int e = errno;
     FILE *fp = af->fp;
     af->fp = NULL;
-    if (fclose(fp) != 0) /* cookie_close closes the descriptor */
-        goto fail;
-    op = "rename";
-    if (fault_check("rename") != 0 || rename(af->tmp, af->target) != 0)
-        goto fail;
+    int closed = fclose(fp); /* cookie_close closes the descriptor */
+    if (rc == 0 && closed != 0) {
+        *op = "close";
+        return -1;
+    }
+    errno = e;
+    return rc;
+}
+
+static void sync_dir(const char *dir)
+{
     /* The rename is durable only once the directory entry is; a failure here
      * leaves a complete file in place, so it is not reported as an error. */
-    int dfd = open(af->dir, O_RDONLY | O_DIRECTORY);
+    int dfd = open(dir, O_RDONLY | O_DIRECTORY);
     if (dfd >= 0) {
         fsync(dfd);
         close(dfd);
     }
-    release(af, 0);
-    return 0;
-fail:;
+}
+
+int atomic_file_commit_all(atomic_file **afs, size_t n, size_t *failed, const char **failed_op)
+{
+    const char *op = NULL;
+    size_t k = 0;
+    int rc = 0;
+    for (; k < n && rc == 0; k++)
+        rc = finish(afs[k], &op);
+    if (rc == 0) {
+        op = "rename";
+        for (k = 0; k < n && rc == 0; k++)
+            if (!afs[k]->direct &&
+                (fault_check("rename") != 0 || rename(afs[k]->tmp, afs[k]->target) != 0))
+                rc = -1;
+        for (size_t i = 0; i < n && rc == 0; i++)
+            if (!afs[i]->direct)
+                sync_dir(afs[i]->dir);
+    }
     int e = errno;
-    if (af->fp)
-        fclose(af->fp);
-    af->fp = NULL;
-    release(af, 1);
-    if (failed_op)
-        *failed_op = op;
-    errno = e;
-    return -1;
+    /* k is one past the file that failed; the ones renamed before it stay */
+    for (size_t i = 0; i < n; i++) {
+        if (afs[i]->fp)
+            fclose(afs[i]->fp);
+        afs[i]->fp = NULL;
+        release(afs[i], rc != 0 && (op != NULL && strcmp(op, "rename") == 0 ? i + 1 >= k : 1));
+    }
+    if (rc != 0) {
+        if (failed)
+            *failed = k - 1;
+        if (failed_op)
+            *failed_op = op;
+        errno = e;
+    }
+    return rc;
+}
+
+int atomic_file_commit(atomic_file *af, const char **failed_op)
+{
+    return atomic_file_commit_all(&af, 1, NULL, failed_op);
 }
 
 void atomic_file_abort(atomic_file *af)

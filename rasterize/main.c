@@ -9,8 +9,11 @@
 #include <unistd.h>
 
 #include "common/atomic_file.h"
+#include "common/close_stdout.h"
 #include "common/diag.h"
 #include "common/limits.h"
+#include "common/output_path.h"
+#include "common/output_set.h"
 #include "common/parse_num.h"
 #include "common/test_hooks.h"
 #include "common/version.h"
@@ -34,7 +37,8 @@ static const char help_text[] =
     "voxels they pass through (normal, plane offset, surface) as a sparse octree,\n"
     "with each surface's compiled function (for render --exact).\n"
     "\n"
-    "  -o, --output OUT.oct   output file (written atomically: all or nothing)\n"
+    "  -o, --output OUT.oct   output file (written atomically: all or nothing;\n"
+    "                         '-': standard output, the summary then on stderr)\n"
     "  --levels N             octree levels: a 2^N grid over the cube enclosing the\n"
     "                         scene's bounds (1.." LIMIT_STR(OCT_MAX_LEVELS) ", default 10)\n"
     "  --method M             interval (default): drop a cell when the interval of f\n"
@@ -89,19 +93,19 @@ static long peak_rss_kib(void)
     return getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_maxrss : 0;
 }
 
-static void print_summary(const char *out, unsigned levels, const build_stats *st, uint64_t bytes,
-                          double seconds)
+static void print_summary(FILE *to, const char *out, unsigned levels, const build_stats *st,
+                          uint64_t bytes, double seconds)
 {
-    printf("rasterize: %s: levels %u (%u^3), %llu voxels, %llu nodes, %llu bytes (%.2f bytes/voxel)\n",
+    fprintf(to, "rasterize: %s: levels %u (%u^3), %llu voxels, %llu nodes, %llu bytes (%.2f bytes/voxel)\n",
            out, levels, 1u << levels, (unsigned long long)st->voxels, (unsigned long long)st->nodes,
            (unsigned long long)bytes, st->voxels ? (double)bytes / (double)st->voxels : 0.0);
-    printf("rasterize: evaluations: %llu interval, %llu interval-gradient, %llu point; "
+    fprintf(to, "rasterize: evaluations: %llu interval, %llu interval-gradient, %llu point; "
            "pruning ran %.1f%% of the instructions; %llu voxels dropped by the Taylor test\n",
            (unsigned long long)st->interval_evals, (unsigned long long)st->gradient_evals,
            (unsigned long long)st->point_evals,
            st->insns_full ? 100.0 * (double)st->insns_evaluated / (double)st->insns_full : 100.0,
            (unsigned long long)st->taylor_drops);
-    printf("rasterize: %llu cells where f may be undefined, %llu normal fallbacks; "
+    fprintf(to, "rasterize: %llu cells where f may be undefined, %llu normal fallbacks; "
            "%.3f s, peak memory %.1f MiB\n",
            (unsigned long long)st->nan_cells, (unsigned long long)st->normal_fallbacks, seconds,
            (double)peak_rss_kib() / 1024.0);
@@ -206,6 +210,50 @@ static int parse_options(int argc, char **argv, options *o)
     return -1;
 }
 
+/* Writes the finished tree to out_path, all or nothing (atomic_file.h).
+ * Returns 0, or -1 after the message. */
+static int write_output(oct_writer *w, const char *out_path, uint64_t *bytes)
+{
+    atomic_file *af = atomic_file_open(out_path);
+    if (!af) {
+        diag_path_error(out_path, "%s", strerror(errno));
+        return -1;
+    }
+    oct_err err = oct_writer_finish(w, atomic_file_stream(af), bytes);
+    if (err != OCT_OK) {
+        diag_path_error(out_path, "write: %s", err == OCT_EIO ? strerror(errno) : oct_strerror(err));
+        atomic_file_abort(af);
+        return -1;
+    }
+    const char *op = NULL;
+    if (atomic_file_commit(af, &op) != 0) {
+        diag_path_error(out_path, "%s: %s", op, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+/* One file in two roles (the output is the scene or one of --merge's
+ * parts), or an output that cannot be written: refused before any work.
+ * Returns EXIT_OK or the exit status. */
+static int check_files(const options *o)
+{
+    output_use *uses = malloc((o->nparts + 1) * sizeof *uses);
+    if (!uses) {
+        diag_error("out of memory");
+        return EXIT_RUNTIME;
+    }
+    for (size_t i = 0; i < o->nparts; i++)
+        uses[i] = (output_use){o->parts[i], o->merge ? "a part" : "the scene", 0, 1};
+    uses[o->nparts] = (output_use){o->out_path, "-o", 0, 0};
+    char msg[2 * 4096 + 256];
+    int rc = output_set_check(uses, o->nparts + 1, msg, sizeof msg);
+    free(uses);
+    if (rc != EXIT_OK)
+        diag_error("%s", rc < 0 ? "out of memory" : msg);
+    return rc < 0 ? EXIT_RUNTIME : rc;
+}
+
 /* Rasterizes the scene (or one shard of it) into the output file. */
 static int rasterize_scene(const options *o)
 {
@@ -214,7 +262,6 @@ static int rasterize_scene(const options *o)
     int status = EXIT_RUNTIME;
     scene *sc = NULL;
     oct_writer *w = NULL;
-    atomic_file *af = NULL;
     unsigned char *function = NULL;
     double t0 = now_seconds();
     scene_error serr;
@@ -277,43 +324,29 @@ static int rasterize_scene(const options *o)
         goto done;
     }
 
-    af = atomic_file_open(out_path);
-    if (!af) {
-        diag_path_error(out_path, "%s", strerror(errno));
-        goto done;
-    }
     uint64_t bytes = 0;
-    err = oct_writer_finish(w, atomic_file_stream(af), &bytes);
-    if (err != OCT_OK) {
-        diag_path_error(out_path, "write: %s", err == OCT_EIO ? strerror(errno) : oct_strerror(err));
+    if (write_output(w, out_path, &bytes) != 0)
         goto done;
-    }
-    const char *op = NULL;
-    atomic_file *committing = af;
-    af = NULL;
-    if (atomic_file_commit(committing, &op) != 0) {
-        diag_path_error(out_path, "%s: %s", op, strerror(errno));
-        goto done;
-    }
+    /* with the tree on stdout, the summary goes to stderr */
+    FILE *to = output_path_is_stdout(out_path) ? stderr : stdout;
     if (!o->quiet) {
         if (bp.shard)
-            printf("rasterize: shard %u/%u: cells [%llu, %llu) of depth %u, %.2f%% of the estimated work "
+            fprintf(to, "rasterize: shard %u/%u: cells [%llu, %llu) of depth %u, %.2f%% of the estimated work "
                    "(partition crc %08x)\n",
                    (unsigned)shard.index, (unsigned)shard.count, (unsigned long long)shard.lo,
                    (unsigned long long)shard.hi, (unsigned)shard.depth, 100.0 * share,
                    (unsigned)shard.crc);
-        print_summary(out_path, levels, &st, bytes, now_seconds() - t0);
+        print_summary(to, out_path, levels, &st, bytes, now_seconds() - t0);
     }
     status = EXIT_OK;
 done:
-    atomic_file_abort(af);
     oct_writer_free(w);
     free(function);
     scene_free(sc);
     return status;
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     diag_set_progname("rasterize");
     test_hooks_init();
@@ -321,7 +354,12 @@ int main(int argc, char **argv)
     int rc = parse_options(argc, argv, &o);
     if (rc >= 0)
         return rc;
+    rc = check_files(&o);
+    if (rc != EXIT_OK)
+        return rc;
     if (o.merge)
         return merge_main(o.out_path, o.parts, o.nparts, o.quiet);
     return rasterize_scene(&o);
 }
+
+int main(int argc, char **argv) { return close_stdout(run(argc, argv)); }

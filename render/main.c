@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "common/view/camera.h"
+#include "common/close_stdout.h"
 #include "common/diag.h"
 #include "common/limits.h"
 #include "common/view/image.h"
@@ -23,6 +24,7 @@
 #include "render/frame.h"
 #include "render/framing.h"
 #include "render/map_guard.h"
+#include "render/outputs.h"
 #include "render/shade.h"
 #include "render/trace.h"
 #include "render/views.h"
@@ -43,7 +45,7 @@ static const char usage_text[] =
 static const char help_text[] =
     "\n"
     "Ray traces the voxels of FILE.oct (two-step discrete ray tracing).\n"
-    "  -o OUT.png          colour image (8-bit sRGB PNG)\n"
+    "  -o OUT.png          colour image (8-bit sRGB PNG; '-': standard output)\n"
     "  --size WxH          image size in pixels (default 512x512, each 1.." LIMIT_STR(CAMERA_MAX_SIZE) ")\n"
     "  --eye, --target     camera position and aim (default: a view framing the occupied voxels)\n"
     "  --up X,Y,Z          up direction (default 0,0,1)\n"
@@ -110,45 +112,6 @@ static void report_line(void *ctx, unsigned line, const char *msg)
     fprintf(stderr, "%s:%u: %s\n", c->path, line, msg);
 }
 
-/* Reads a whole text file into a malloc'ed NUL-terminated buffer. */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 4096, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t got = fread(buf + n, 1, cap - n - 1, f);
-        n += got;
-        if (n + 1 < cap) {
-            if (ferror(f)) {
-                free(buf);
-                buf = NULL;
-            }
-            break;
-        }
-        char *nb = realloc(buf, cap * 2);
-        if (!nb) {
-            free(buf);
-            buf = NULL;
-        }
-        buf = nb;
-        cap *= 2;
-    }
-    int e = errno;
-    fclose(f);
-    if (buf)
-        buf[n] = '\0';
-    errno = e;
-    return buf;
-}
-
-/* True when path ends in ".pfm": --normals then writes float normals. */
-static int is_pfm(const char *path)
-{
-    size_t n = strlen(path);
-    return n >= 4 && strcmp(path + n - 4, ".pfm") == 0;
 }
 
 /* The command line. */
@@ -215,9 +178,10 @@ static int check_args(const render_args *o)
         return diag_usage_error(usage_text, "%s", "-o goes into the views file with --views");
     if (!o->views_path && !o->base.out && !o->info)
         return diag_usage_error(usage_text, "%s", "no output: give -o OUT.png or --views FILE");
-    if (o->orbit && views_check_pattern(o->base.out) != 0)
-        return diag_usage_error(usage_text, "--orbit: -o '%s' must hold exactly one integer conversion such as %%04d",
-                           o->base.out);
+    int pattern = o->orbit ? views_check_pattern(o->base.out) : 0;
+    if (pattern != 0)
+        return diag_usage_error(usage_text, "--orbit: -o '%s': %s", o->base.out,
+                                views_orbit_strerror(pattern == -2 ? VIEWS_ORBIT_WIDTH : VIEWS_ORBIT_PATTERN));
     char msg[512];
     if (!o->views_path && views_check(&o->base, msg, sizeof msg) != 0)
         return diag_usage_error(usage_text, "%s", msg);
@@ -287,8 +251,14 @@ static int parse_args(int argc, char **argv, render_args *o)
 static int load_views_file(const render_args *o, const views_view *base, char **text,
                            views_view **list, size_t *nviews)
 {
-    *text = read_text(o->views_path);
-    if (!*text) {
+    unsigned line = 0, col = 0;
+    const char *what = NULL;
+    int rr = views_read_file(o->views_path, text, &line, &col, &what);
+    if (rr == -2) {
+        diag_at(o->views_path, line, col, "%s", what);
+        return EXIT_USAGE;
+    }
+    if (rr != 0) {
         diag_path_error(o->views_path, "%s", strerror(errno));
         return EXIT_RUNTIME;
     }
@@ -337,9 +307,13 @@ static int command_line_views(const oct_tree *tree, const render_args *o, views_
 {
     framing_default_view(tree, base);
     if (o->orbit) {
-        *list = views_orbit(base, (unsigned)o->orbit, base->out);
-        if (!*list)
-            return diag_usage_error(usage_text, "%s", "--orbit: the eye lies on the up axis through the target");
+        views_orbit_err e = views_orbit(base, (unsigned)o->orbit, base->out, list);
+        if (e == VIEWS_ORBIT_NOMEM) {
+            diag_error("--orbit: out of memory for %ld views", o->orbit);
+            return EXIT_RUNTIME;
+        }
+        if (e != VIEWS_ORBIT_OK)
+            return diag_usage_error(usage_text, "--orbit: %s", views_orbit_strerror(e));
         *nviews = (size_t)o->orbit;
         return EXIT_OK;
     }
@@ -397,8 +371,8 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     for (size_t k = 0; k < nviews; k++) {
         want_alpha |= list[k].alpha;
         want_depth |= list[k].depth != NULL;
-        want_nrm |= list[k].normals != NULL && !is_pfm(list[k].normals);
-        want_nrm_f |= list[k].normals != NULL && is_pfm(list[k].normals);
+        want_nrm |= list[k].normals != NULL && !outputs_is_pfm(list[k].normals);
+        want_nrm_f |= list[k].normals != NULL && outputs_is_pfm(list[k].normals);
     }
     if (want_depth)
         buf->depth = malloc(max_px * sizeof *buf->depth);
@@ -463,8 +437,8 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
         shade_default_light(cam, job.shade.light);
     job.rgb = buf->rgb;
     job.depth = v->depth ? buf->depth : NULL;
-    job.normals = v->normals && !is_pfm(v->normals) ? buf->nrm : NULL;
-    job.normals_f = v->normals && is_pfm(v->normals) ? buf->nrm_f : NULL;
+    job.normals = v->normals && !outputs_is_pfm(v->normals) ? buf->nrm : NULL;
+    job.normals_f = v->normals && outputs_is_pfm(v->normals) ? buf->nrm_f : NULL;
     job.threads = (unsigned)o->threads;
     job.beam_size = (unsigned)o->beam;
     job.aa = (unsigned)v->aa;
@@ -490,23 +464,16 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     }
     *total_ms += ms;
     *total_rays += st.rays;
-    const char *op = NULL;
     const uint32_t w = (uint32_t)v->width, h = (uint32_t)v->height;
-    if ((v->alpha ? image_write_png_alpha(v->out, buf->rgb, buf->alpha, w, h, &op)
-                  : image_write_png(v->out, buf->rgb, w, h, &op)) != 0) {
-        diag_path_error(v->out, "%s: %s", op ? op : "write", strerror(errno));
+    outputs_images img = {.rgb = buf->rgb,
+                          .nrm = buf->nrm,
+                          .alpha = v->alpha ? buf->alpha : NULL,
+                          .depth = buf->depth,
+                          .nrm_f = buf->nrm_f,
+                          .width = w,
+                          .height = h};
+    if (outputs_write_view(v, &img) != EXIT_OK)
         return EXIT_RUNTIME;
-    }
-    if (v->depth && image_write_pfm(v->depth, buf->depth, w, h, &op) != 0) {
-        diag_path_error(v->depth, "%s: %s", op ? op : "write", strerror(errno));
-        return EXIT_RUNTIME;
-    }
-    if (v->normals &&
-        (is_pfm(v->normals) ? image_write_pfm_rgb(v->normals, buf->nrm_f, w, h, &op)
-                            : image_write_png(v->normals, buf->nrm, w, h, &op)) != 0) {
-        diag_path_error(v->normals, "%s: %s", op ? op : "write", strerror(errno));
-        return EXIT_RUNTIME;
-    }
     if (!o->quiet)
         report_view(o, v, &st, ms);
     return EXIT_OK;
@@ -543,7 +510,7 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
     return EXIT_OK;
 }
 
-int main(int argc, char **argv)
+static int run(int argc, char **argv)
 {
     diag_set_progname("render");
     test_hooks_init();
@@ -595,6 +562,8 @@ int main(int argc, char **argv)
     if (!o.views_path)
         status = command_line_views(tree, &o, &o.base, &list, &nviews);
     if (status == EXIT_OK)
+        status = outputs_check(o.oct_path, o.views_path, list, nviews);
+    if (status == EXIT_OK)
         status = prepare_views(tree, o.views_path, list, nviews, &cams, &buf);
     if (status != EXIT_OK)
         goto done;
@@ -626,3 +595,5 @@ done:
     oct_close(file);
     return status;
 }
+
+int main(int argc, char **argv) { return close_stdout(run(argc, argv)); }

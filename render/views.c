@@ -1,6 +1,7 @@
 /* views: per-view options, views files, orbits. */
 #include "render/views.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -197,8 +198,12 @@ int views_check_pattern(const char *p)
             continue;
         while (*p && strchr("0-+ ", *p))
             p++;
-        while (*p >= '0' && *p <= '9')
-            p++;
+        long width = 0;
+        for (; *p >= '0' && *p <= '9'; p++) {
+            width = width * 10 + (*p - '0');
+            if (width > NAME_MAX)
+                return -2; /* no file name is that long: refused before snprintf */
+        }
         if (*p != 'd' && *p != 'i' && *p != 'u')
             return -1;
         conv++;
@@ -206,17 +211,37 @@ int views_check_pattern(const char *p)
     return conv == 1 ? 0 : -1;
 }
 
+const char *views_orbit_strerror(views_orbit_err e)
+{
+    switch (e) {
+    case VIEWS_ORBIT_OK: return "no error";
+    case VIEWS_ORBIT_PATTERN: return "-o must hold exactly one integer conversion such as %04d";
+    case VIEWS_ORBIT_WIDTH: return "the conversion's field width is over " LIMIT_STR(NAME_MAX) " (NAME_MAX)";
+    case VIEWS_ORBIT_NAME: return "a frame's name is " LIMIT_STR(PATH_MAX) " bytes (PATH_MAX) or more";
+    case VIEWS_ORBIT_AXIS: return "the eye lies on the up axis through the target";
+    case VIEWS_ORBIT_NOMEM: return "out of memory";
+    }
+    return "unknown error";
+}
+
 /* The pattern is checked by views_check_pattern: one integer conversion. */
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wformat-nonliteral"
-views_view *views_orbit(const views_view *base, unsigned n, const char *pattern)
+views_orbit_err views_orbit(const views_view *base, unsigned n, const char *pattern,
+                            views_view **out)
 {
-    if (n == 0 || views_check_pattern(pattern) != 0)
-        return NULL;
+    *out = NULL;
+    int pc = views_check_pattern(pattern);
+    if (n == 0 || n > INT_MAX || pc != 0)
+        return pc == -2 ? VIEWS_ORBIT_WIDTH : VIEWS_ORBIT_PATTERN;
+    /* Frame numbers only grow, so the last frame's name is the longest. */
+    int longest = snprintf(NULL, 0, pattern, (int)(n - 1));
+    if (longest < 0 || longest >= PATH_MAX)
+        return VIEWS_ORBIT_NAME;
     double un = sqrt(base->up[0] * base->up[0] + base->up[1] * base->up[1] +
                      base->up[2] * base->up[2]);
     if (!(un > 0.0))
-        return NULL;
+        return VIEWS_ORBIT_AXIS;
     double ax[3], rel[3], h = 0.0;
     for (int a = 0; a < 3; a++) {
         ax[a] = base->up[a] / un;
@@ -230,17 +255,15 @@ views_view *views_orbit(const views_view *base, unsigned n, const char *pattern)
     }
     r = sqrt(r);
     if (!(r > 0.0))
-        return NULL;
+        return VIEWS_ORBIT_AXIS;
     for (int a = 0; a < 3; a++)
         e1[a] /= r;
     double e2[3] = {ax[1] * e1[2] - ax[2] * e1[1], ax[2] * e1[0] - ax[0] * e1[2],
                     ax[0] * e1[1] - ax[1] * e1[0]};
-    int len = snprintf(NULL, 0, pattern, (int)n) + 16;
-    if (len <= 16)
-        return NULL;
-    views_view *arr = malloc(n * (sizeof *arr + (size_t)len));
+    size_t len = (size_t)longest + 1;
+    views_view *arr = malloc(n * (sizeof *arr + len));
     if (!arr)
-        return NULL;
+        return VIEWS_ORBIT_NOMEM;
     char *names = (char *)(arr + n);
     for (unsigned k = 0; k < n; k++) {
         double ang = 2.0 * M_PI * (double)k / (double)n;
@@ -249,12 +272,13 @@ views_view *views_orbit(const views_view *base, unsigned n, const char *pattern)
         for (int a = 0; a < 3; a++)
             arr[k].eye[a] = base->target[a] + h * ax[a] + r * (c * e1[a] + s * e2[a]);
         arr[k].has_eye = 1;
-        char *name = names + (size_t)k * (size_t)len;
-        snprintf(name, (size_t)len, pattern, (int)k);
+        char *name = names + (size_t)k * len;
+        snprintf(name, len, pattern, (int)k);
         arr[k].out = name;
         arr[k].depth = NULL;
         arr[k].normals = NULL;
     }
-    return arr;
+    *out = arr;
+    return VIEWS_ORBIT_OK;
 }
 #pragma GCC diagnostic pop

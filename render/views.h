@@ -65,16 +65,44 @@ int views_parse(char *text, const views_view *base, views_view **out, size_t *co
                 views_report_fn report, void *ctx);
 
 /* 0 when `pattern` holds exactly one integer conversion (%d, %i, %u with
- * optional flags "0-+ " and width, e.g. %04d) and otherwise only "%%";
- * -1 otherwise. */
+ * optional flags "0-+ " and a width of at most NAME_MAX, e.g. %04d) and
+ * otherwise only "%%"; -2 for a wider width, -1 otherwise. */
 int views_check_pattern(const char *pattern);
+
+typedef enum views_orbit_err {
+    VIEWS_ORBIT_OK,
+    VIEWS_ORBIT_PATTERN, /* not one integer conversion */
+    VIEWS_ORBIT_WIDTH,   /* a field width over NAME_MAX */
+    VIEWS_ORBIT_NAME,    /* a formatted name of PATH_MAX bytes or more */
+    VIEWS_ORBIT_AXIS,    /* the eye lies on the up axis */
+    VIEWS_ORBIT_NOMEM,
+} views_orbit_err;
+
+const char *views_orbit_strerror(views_orbit_err e);
 
 /* n views on a circle around base's target, about its up axis, at the eye's
  * distance from the up axis and its height along it, starting at the eye.
  * Outputs are pattern formatted with the frame number (0..n-1), written into
- * one malloc'ed block owned by the returned array (free the array only).
- * Depth and normals are not written. NULL on allocation failure or when the
- * eye lies on the axis. */
-views_view *views_orbit(const views_view *base, unsigned n, const char *pattern);
+ * one malloc'ed block owned by the array stored in *out (free the array
+ * only). Depth and normals are not written. Returns VIEWS_ORBIT_OK, or the
+ * reason with *out NULL. */
+views_orbit_err views_orbit(const views_view *base, unsigned n, const char *pattern,
+                            views_view **out);
+
+/* Views-file limits, as the scene reader has its own: a views file is read
+ * whole, and a hostile one (or /dev/urandom) must not take the memory. */
+#define VIEWS_MAX_FILE 16777216 /* bytes in one views file (16 MiB) */
+#define VIEWS_MAX_LINE 65536    /* bytes in one line, comment included */
+
+/* Reads the views file at path (at most VIEWS_MAX_FILE bytes, lines of at
+ * most VIEWS_MAX_LINE bytes, no NUL byte) into a malloc'ed NUL-terminated
+ * *text. Returns 0; or -1 with errno (I/O; ENOMEM); or -2 for a file over
+ * the limits, with *line, *col (1-based) and *msg (static) saying where and
+ * what. */
+int views_read_file(const char *path, char **text, unsigned *line, unsigned *col,
+                    const char **msg);
+
+/* The same checks on text already in memory (n bytes): 0, or -2 as above. */
+int views_check_text(const char *text, size_t n, unsigned *line, unsigned *col, const char **msg);
 
 #endif

@@ -73,7 +73,7 @@ static void test_plane_alone_is_open(void **state)
         assert_non_null(t);
         for (unsigned impl = 0; impl < trace_impl_count; impl++)
             for (int refine = 0; refine <= 1; refine++) {
-                trace_opts o = {LEVELS, refine};
+                trace_opts o = {.split = LEVELS, .refine = refine};
                 unsigned tested = 0;
                 for (double y = 4.3; y < 60; y += 5.1)
                     for (double x = 4.7; x < 60; x += 5.3) {
@@ -99,7 +99,7 @@ static void test_concave_corner_is_darker(void **state)
     assert_non_null(t);
     for (unsigned impl = 0; impl < trace_impl_count; impl++)
         for (int refine = 0; refine <= 1; refine++) {
-            trace_opts o = {LEVELS, refine};
+            trace_opts o = {.split = LEVELS, .refine = refine};
             trace_traverse_fn fn = trace_impls[impl].traverse;
             /* AO_DISTANCE is 8 voxels here: open beyond it, dark near the wall */
             const float open = factor_at(t, &o, fn, 40.5, 30.5, 256);

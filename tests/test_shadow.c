@@ -40,7 +40,7 @@ typedef void (*voxel_fn)(const oct_tree *t, uint64_t k, const uint32_t xyz[3], v
 static void each_voxel(const oct_tree *t, voxel_fn fn, void *ctx)
 {
     const uint32_t n = UINT32_C(1) << t->levels;
-    trace_opts o = {t->levels, 0};
+    trace_opts o = {.split = t->levels};
     /* find each voxel by a ray straight down its column: slow but plain */
     for (uint32_t y = 0; y < n; y++)
         for (uint32_t x = 0; x < n; x++) {
@@ -112,7 +112,7 @@ static void test_no_acne_on_planes(void **state)
                     for (int a = 0; a < 3; a++)
                         light[a] = cos(el) * (cos(az) * tu[a] / tl + sin(az) * tv[a] / tl) +
                                    sin(el) * s.n[a];
-                    acne_ctx c = {{LEVELS, refine}, trace_impls[impl].traverse, light, 0, 0};
+                    acne_ctx c = {{.split = LEVELS, .refine = refine}, trace_impls[impl].traverse, light, 0, 0};
                     each_voxel(t, acne_voxel, &c);
                     assert_true(c.tested > 500);
                     if (c.blocked)
@@ -147,7 +147,7 @@ static void test_thin_wall_does_not_leak(void **state)
     unsigned shadowed = 0, lit = 0;
     for (unsigned impl = 0; impl < trace_impl_count; impl++)
         for (int refine = 0; refine <= 1; refine++) {
-            trace_opts o = {LEVELS, refine};
+            trace_opts o = {.split = LEVELS, .refine = refine};
             for (uint32_t y = 2; y < 62; y += 3)
                 for (uint32_t x = 2; x < 62; x += 3) {
                     /* the floor voxel under (x, y), found from above the wall's gap */
@@ -194,7 +194,7 @@ static void test_wall_lit_from_behind_is_dark(void **state)
     p.ambient = 0.2f;
     const double l[3] = {0.1, 0.2, -1.0};
     assert_int_equal(shade_set_light(&p, l), 0);
-    trace_opts o = {LEVELS, 0};
+    trace_opts o = {.split = LEVELS};
     double eye[3] = {30.5, 31.5, 50.0}, dir[3] = {0, 0, -1};
     trace_hit h;
     assert_true(trace_ray_cast(t, &o, eye, dir, &h));

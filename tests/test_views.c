@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -108,6 +109,58 @@ static void test_orbit_patterns(void **state)
     assert_int_equal(views_check_pattern("%ld.png"), -1);
     assert_int_equal(views_check_pattern("%*d.png"), -1);
     assert_int_equal(views_check_pattern("x%"), -1);
+    /* A width no file name can hold is refused before any formatting. */
+    assert_int_equal(views_check_pattern("f%0255d.png"), 0);
+    assert_int_equal(views_check_pattern("f%256d.png"), -2);
+    assert_int_equal(views_check_pattern("f%2147483647d.png"), -2);
+    assert_int_equal(views_check_pattern("f%99999999999999999999999d.png"), -2);
+}
+
+/* The out-of-memory case asks for ~300 GB: under AddressSanitizer malloc
+ * must then return NULL, as libc's does, instead of aborting. */
+const char *__asan_default_options(void);
+const char *__asan_default_options(void) { return "allocator_may_return_null=1"; }
+
+/* Every orbit failure has its own reason, out of memory included. */
+static void test_orbit_errors(void **state)
+{
+    (void)state;
+    views_view base, *v = (views_view *)&base;
+    views_defaults(&base);
+    base.eye[0] = 3;
+    assert_int_equal(views_orbit(&base, 4, "f%2147483647d.png", &v), VIEWS_ORBIT_WIDTH);
+    assert_null(v);
+    assert_int_equal(views_orbit(&base, 4, "f%s.png", &v), VIEWS_ORBIT_PATTERN);
+    static char longp[PATH_MAX + 8];
+    memset(longp, 'p', sizeof longp - 1);
+    memcpy(longp + 10, "%d", 2);
+    assert_int_equal(views_orbit(&base, 4, longp, &v), VIEWS_ORBIT_NAME);
+    assert_int_equal(views_orbit(&base, 2000000000u, "%d", &v), VIEWS_ORBIT_NOMEM);
+    assert_null(v);
+    assert_string_equal(views_orbit_strerror(VIEWS_ORBIT_NOMEM), "out of memory");
+}
+
+/* The views file's limits: NUL bytes and long lines with FILE:LINE:COL. */
+static void test_views_text_limits(void **state)
+{
+    (void)state;
+    unsigned line = 0, col = 0;
+    const char *msg = NULL;
+    static const char nul[] = "-o a.png\n-o b\0.png\n";
+    assert_int_equal(views_check_text(nul, sizeof nul - 1, &line, &col, &msg), -2);
+    assert_int_equal(line, 2);
+    assert_int_equal(col, 5);
+    assert_non_null(strstr(msg, "NUL"));
+    size_t n = VIEWS_MAX_LINE + 10;
+    char *big = malloc(n + 1);
+    assert_non_null(big);
+    memset(big, ' ', n);
+    big[0] = '\n';
+    assert_int_equal(views_check_text(big, VIEWS_MAX_LINE + 1, &line, &col, &msg), 0);
+    assert_int_equal(views_check_text(big, VIEWS_MAX_LINE + 2, &line, &col, &msg), -2);
+    assert_int_equal(line, 2);
+    assert_non_null(strstr(msg, "65536"));
+    free(big);
 }
 
 static void test_orbit_geometry(void **state)
@@ -118,7 +171,8 @@ static void test_orbit_geometry(void **state)
     const double eye[3] = {3, 0, 2}, target[3] = {0, 0, 1};
     memcpy(base.eye, eye, sizeof eye);
     memcpy(base.target, target, sizeof target);
-    views_view *v = views_orbit(&base, 4, "f_%03d.png");
+    views_view *v = NULL;
+    assert_int_equal(views_orbit(&base, 4, "f_%03d.png", &v), VIEWS_ORBIT_OK);
     assert_non_null(v);
     assert_string_equal(v[0].out, "f_000.png");
     assert_string_equal(v[3].out, "f_003.png");
@@ -128,7 +182,8 @@ static void test_orbit_geometry(void **state)
         assert_true(fabs(v[k].eye[2] - 2) < 1e-12);
     free(v);
     base.eye[0] = 0; /* on the axis */
-    assert_null(views_orbit(&base, 4, "f_%03d.png"));
+    assert_int_equal(views_orbit(&base, 4, "f_%03d.png", &v), VIEWS_ORBIT_AXIS);
+    assert_null(v);
 }
 
 int main(void)
@@ -138,6 +193,8 @@ int main(void)
         cmocka_unit_test(test_every_bad_line_reported),
         cmocka_unit_test(test_empty_file),
         cmocka_unit_test(test_orbit_patterns),
+        cmocka_unit_test(test_orbit_errors),
+        cmocka_unit_test(test_views_text_limits),
         cmocka_unit_test(test_orbit_geometry),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

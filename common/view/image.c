@@ -54,37 +54,40 @@ static void png_flush_cb(png_structp png)
     (void)png;
 }
 
-/* RGB, or RGBA when alpha is not NULL (each row interleaved in `row`,
- * 4 * w bytes). */
-static int write_png(const char *path, const uint8_t *rgb, const uint8_t *alpha, uint8_t *row,
-                     uint32_t w, uint32_t h, const char **failed_op)
+int image_png_to(atomic_file *af, const uint8_t *rgb, uint32_t w, uint32_t h)
 {
-    const char *op = "open";
-    atomic_file *af = atomic_file_open(path);
-    if (!af) {
-        if (failed_op)
-            *failed_op = op;
+    return image_png_alpha_to(af, rgb, NULL, w, h);
+}
+
+int image_png_alpha_to(atomic_file *af, const uint8_t *rgb, const uint8_t *alpha, uint32_t w,
+                       uint32_t h)
+{
+    size_t bytes;
+    if (image_rgb_size(w, h, &bytes) != 0 || w > PNG_UINT_31_MAX / 4 || h > PNG_UINT_31_MAX) {
+        errno = EOVERFLOW;
+        return -1;
+    }
+    uint8_t *row = alpha ? malloc(4 * (size_t)w) : NULL; /* RGBA rows, interleaved */
+    if (alpha && !row) {
+        errno = ENOMEM;
         return -1;
     }
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, png_fail, png_warn);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     volatile int err = 0;
     if (!png || !info) {
-        errno = ENOMEM;
-        op = "png";
+        err = ENOMEM;
         goto fail;
     }
     if (setjmp(png_jmpbuf(png))) {
         /* 2: our write callback failed and set errno; 1: libpng's own error */
         err = errno ? errno : EIO;
-        op = "write";
         goto fail;
     }
     errno = 0;
     png_set_write_fn(png, af, png_write_cb, png_flush_cb);
     png_set_IHDR(png, info, w, h, 8, alpha ? PNG_COLOR_TYPE_RGBA : PNG_COLOR_TYPE_RGB,
-                 PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     /* Rendered frames are flat background and smooth shading: the SUB filter
      * and run-length deflate keep them within a fifth of the default size
@@ -107,79 +110,59 @@ static int write_png(const char *path, const uint8_t *rgb, const uint8_t *alpha,
     }
     png_write_end(png, info);
     png_destroy_write_struct(&png, &info);
-    if (atomic_file_commit(af, failed_op) != 0)
-        return -1;
+    free(row);
     return 0;
 fail:
     png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
-    atomic_file_abort(af);
-    if (err)
-        errno = err;
-    if (failed_op)
-        *failed_op = op;
+    free(row);
+    errno = err;
     return -1;
 }
 
-static int png_size_ok(uint32_t w, uint32_t h, const char **failed_op)
+/* Opens path, writes through `to` and commits; shared by the path writers. */
+static int write_path(const char *path, int (*to)(atomic_file *, const void *, uint32_t, uint32_t),
+                      const void *data, uint32_t w, uint32_t h, const char **failed_op)
 {
-    size_t bytes;
-    if (image_rgb_size(w, h, &bytes) != 0 || w > PNG_UINT_31_MAX / 4 || h > PNG_UINT_31_MAX) {
-        errno = EOVERFLOW;
-        if (failed_op)
-            *failed_op = "size";
-        return 0;
-    }
-    return 1;
-}
-
-int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h,
-                    const char **failed_op)
-{
-    if (!png_size_ok(w, h, failed_op))
-        return -1;
-    return write_png(path, rgb, NULL, NULL, w, h, failed_op);
-}
-
-int image_write_png_alpha(const char *path, const uint8_t *rgb, const uint8_t *alpha, uint32_t w,
-                          uint32_t h, const char **failed_op)
-{
-    if (!png_size_ok(w, h, failed_op))
-        return -1;
-    uint8_t *row = malloc(4 * (size_t)w);
-    if (!row) {
-        errno = ENOMEM;
-        if (failed_op)
-            *failed_op = "png";
-        return -1;
-    }
-    int r = write_png(path, rgb, alpha, row, w, h, failed_op);
-    int e = errno;
-    free(row);
-    errno = e;
-    return r;
-}
-
-/* PFM with `ch` channels (1: "Pf", 3: "PF"), bottom row first. */
-static int write_pfm(const char *path, const float *values, uint32_t w, uint32_t h, unsigned ch,
-                     const char **failed_op)
-{
-    if (w == 0 || h == 0 || (size_t)w > SIZE_MAX / 4 / ch / (size_t)h) {
-        errno = EOVERFLOW;
-        if (failed_op)
-            *failed_op = "size";
-        return -1;
-    }
     atomic_file *af = atomic_file_open(path);
     if (!af) {
         if (failed_op)
             *failed_op = "open";
         return -1;
     }
+    if (to(af, data, w, h) != 0) {
+        int e = errno;
+        atomic_file_abort(af);
+        errno = e;
+        if (failed_op)
+            *failed_op = e == EOVERFLOW ? "size" : "write";
+        return -1;
+    }
+    return atomic_file_commit(af, failed_op);
+}
+
+static int png_to(atomic_file *af, const void *rgb, uint32_t w, uint32_t h)
+{
+    return image_png_to(af, rgb, w, h);
+}
+
+int image_write_png(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h,
+                    const char **failed_op)
+{
+    return write_path(path, png_to, rgb, w, h, failed_op);
+}
+
+/* PFM with `ch` channels (1: "Pf", 3: "PF"), bottom row first. */
+static int pfm_to(atomic_file *af, const float *values, uint32_t w, uint32_t h, unsigned ch)
+{
+    if (w == 0 || h == 0 || (size_t)w > SIZE_MAX / 4 / ch / (size_t)h) {
+        errno = EOVERFLOW;
+        return -1;
+    }
     char head[64];
     int hn = snprintf(head, sizeof head, "%s\n%u %u\n-1.0\n", ch == 3 ? "PF" : "Pf", (unsigned)w,
                       (unsigned)h);
     if (atomic_file_write(af, head, (size_t)hn) != 0)
-        goto fail;
+        return -1;
     uint8_t row[4096];
     const size_t n = (size_t)w * ch;
     for (uint32_t jj = h; jj-- > 0;) { /* bottom row first */
@@ -194,31 +177,44 @@ static int write_pfm(const char *path, const float *values, uint32_t w, uint32_t
             row[fill++] = (uint8_t)(u >> 24);
             if (fill == sizeof row) {
                 if (atomic_file_write(af, row, fill) != 0)
-                    goto fail;
+                    return -1;
                 fill = 0;
             }
         }
         if (fill && atomic_file_write(af, row, fill) != 0)
-            goto fail;
+            return -1;
     }
-    return atomic_file_commit(af, failed_op);
-fail:;
-    int e = errno;
-    atomic_file_abort(af);
-    errno = e;
-    if (failed_op)
-        *failed_op = "write";
-    return -1;
+    return 0;
+}
+
+int image_pfm_to(atomic_file *af, const float *values, uint32_t w, uint32_t h)
+{
+    return pfm_to(af, values, w, h, 1);
+}
+
+int image_pfm_rgb_to(atomic_file *af, const float *values, uint32_t w, uint32_t h)
+{
+    return pfm_to(af, values, w, h, 3);
+}
+
+static int pfm1_to(atomic_file *af, const void *values, uint32_t w, uint32_t h)
+{
+    return pfm_to(af, values, w, h, 1);
+}
+
+static int pfm3_to(atomic_file *af, const void *values, uint32_t w, uint32_t h)
+{
+    return pfm_to(af, values, w, h, 3);
 }
 
 int image_write_pfm(const char *path, const float *values, uint32_t w, uint32_t h,
                     const char **failed_op)
 {
-    return write_pfm(path, values, w, h, 1, failed_op);
+    return write_path(path, pfm1_to, values, w, h, failed_op);
 }
 
 int image_write_pfm_rgb(const char *path, const float *values, uint32_t w, uint32_t h,
                         const char **failed_op)
 {
-    return write_pfm(path, values, w, h, 3, failed_op);
+    return write_path(path, pfm3_to, values, w, h, failed_op);
 }
