@@ -112,8 +112,6 @@ static void report_line(void *ctx, unsigned line, const char *msg)
     fprintf(stderr, "%s:%u: %s\n", c->path, line, msg);
 }
 
-}
-
 /* The command line. */
 typedef struct render_args {
     views_view base; /* the command line's view options */
