@@ -19,6 +19,7 @@ typedef struct key {
     ino_t ino;
     int has_ino;    /* the file exists */
     int shareable;  /* a character device: any number of uses may share it */
+    unsigned line;  /* the use's view (its views-file line), for the tie order */
     size_t use;
 } key;
 
@@ -106,9 +107,20 @@ static int output_key(const output_use *u, key *k, dir_cache *dc, char *msg, siz
     return rc;
 }
 
+/* Ties (one file) in view order, so that the uses of one view sit side by
+ * side and the inputs (line 0) next to the first view. */
+static int by_view(const key *x, const key *y)
+{
+    if (x->line != y->line)
+        return x->line < y->line ? -1 : 1;
+    return x->use < y->use ? -1 : x->use > y->use;
+}
+
 static int by_canon(const void *a, const void *b)
 {
-    return strcmp(((const key *)a)->canon, ((const key *)b)->canon);
+    const key *x = a, *y = b;
+    int c = strcmp(x->canon, y->canon);
+    return c ? c : by_view(x, y);
 }
 
 static int by_inode(const void *a, const void *b)
@@ -120,7 +132,7 @@ static int by_inode(const void *a, const void *b)
         return x->dev < y->dev ? -1 : 1;
     if (x->ino != y->ino)
         return x->ino < y->ino ? -1 : 1;
-    return 0;
+    return by_view(x, y);
 }
 
 /* Two neighbours after sorting that name one file in two roles. */
@@ -130,7 +142,9 @@ static int clash(const key *a, const key *b, const output_use *uses, int same_in
         return 0;
     if (uses[a->use].is_input && uses[b->use].is_input)
         return 0;
-    return same_inode ? a->has_ino && b->has_ino && by_inode(a, b) == 0
+    if (!uses[a->use].is_input && !uses[b->use].is_input && uses[a->use].line != uses[b->use].line)
+        return 0; /* two views writing one file in turn: the later one's stays */
+    return same_inode ? a->has_ino && b->has_ino && a->dev == b->dev && a->ino == b->ino
                       : strcmp(a->canon, b->canon) == 0;
 }
 
@@ -169,6 +183,7 @@ int output_set_check(const output_use *uses, size_t n, char *msg, size_t msg_siz
         const output_use *u = &uses[made];
         key *k = &keys[made];
         k->use = made;
+        k->line = u->line;
         struct stat st;
         int is_stdout = !u->is_input && output_path_is_stdout(u->path);
         if (is_stdout ? fstat(STDOUT_FILENO, &st) == 0 : stat(u->path, &st) == 0) {

@@ -2,8 +2,10 @@
  * that a run refuses at once what would otherwise fail (or destroy
  * something) after minutes of work:
  *   - one file in two roles: an output that is also an input, or two
- *     outputs naming the same file (same path after resolving the
- *     directory and symlinks, or same inode): EXIT_USAGE. Character
+ *     outputs of one view naming the same file (same path after resolving
+ *     the directory and symlinks, or same inode): EXIT_USAGE. Two views may
+ *     write one file in turn (a benchmark's repeated frames): the later
+ *     view's stays. Character
  *     devices are exempt (any number of outputs may go to /dev/null); "-"
  *     (stdout) is not.
  *   - an output that cannot be written: a name over NAME_MAX / PATH_MAX, a

@@ -83,9 +83,16 @@ expect_exit 2 "$BIN/render" "$T/s.oct" -o "$T/x.png" --normals "$T/./x.png" -q
 expect_err "-o and --normals name the same file"
 expect_exit 2 "$BIN/render" "$T/s.oct" -o - --depth - -q
 [ -e "$T/x.png" ] && fail "a refused run wrote x.png"
+# two views writing one file in turn: allowed, the later view's image stays
 printf -- '-o %s/v1.png\n-o %s/v2.png\n-o %s/v1.png --size 8x8\n' "$T" "$T" "$T" > "$T/views"
+expect_exit 0 "$BIN/render" "$T/s.oct" --views "$T/views" -q
+[ "$(od -An -tx1 -j16 -N8 "$T/v1.png" | tr -d ' ')" = 0000000800000008 ] ||
+    fail "v1.png is not the 8x8 image of views line 3"
+rm -f "$T/v1.png" "$T/v2.png"
+# one view naming a file twice, in a views line: refused
+printf -- '-o %s/v1.png --normals %s/v1.png\n' "$T" "$T" > "$T/views"
 expect_exit 2 "$BIN/render" "$T/s.oct" --views "$T/views" -q
-expect_err "-o (views line 1) and -o (views line 3) name the same file"
+expect_err "-o (views line 1) and --normals (views line 1) name the same file"
 printf -- '-o %s/v1.png --depth %s/views2\n' "$T" "$T" > "$T/views2"
 expect_exit 2 "$BIN/render" "$T/s.oct" --views "$T/views2" -q
 printf -- '-o %s/views3\n' "$T" > "$T/views3"
