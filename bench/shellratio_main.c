@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bench/scene_oct.h"
 #include "common/diag.h"
 #include "common/expr/scene.h"
 #include "common/parse_num.h"
@@ -186,19 +187,10 @@ int main(int argc, char **argv)
     }
     if (!paths[1])
         return diag_usage_error(usage_text, "%s", "want a scene and an octree");
-    scene *sc = NULL;
-    scene_error se;
-    if (scene_load(paths[0], &sc, &se) != 0) {
-        scene_print_error(paths[0], &se);
+    scene *sc;
+    oct_file *f;
+    if (scene_oct_open(paths[0], paths[1], &sc, &f) != EXIT_OK)
         return EXIT_RUNTIME;
-    }
-    oct_file *f = NULL;
-    oct_err err = oct_open(paths[1], 0, &f, NULL);
-    if (err != OCT_OK) {
-        diag_error("%s: %s", paths[1], oct_strerror(err));
-        scene_free(sc);
-        return EXIT_RUNTIME;
-    }
     const oct_tree *t = oct_get_tree(f);
     const oct_info *info = oct_get_info(f);
     int status = EXIT_OK;
