@@ -5,6 +5,7 @@
  * parts sequentially through one buffer, with the header last. */
 #include "format/oct_merge.h"
 #include "format/oct_layout.h"
+#include "format/oct_sink.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -316,20 +317,15 @@ static oct_err check_partition(merge *m)
 
 /* --- pass 3: the output ------------------------------------------------ */
 
+/* The output: the format's sink, and the merge that reports its failure. */
 typedef struct sink {
     merge *m;
-    FILE *f;
-    uLong crc;
-    uint64_t bytes;
+    oct_sink out;
 } sink;
 
 static int put(sink *s, const void *data, size_t n)
 {
-    if (n == 0)
-        return 0;
-    s->crc = crc32_z(s->crc, data, n);
-    s->bytes += n;
-    if (fwrite(data, 1, n, s->f) != n || ferror(s->f)) {
+    if (oct_sink_put(&s->out, data, n) != 0) {
         io_fail(s->m, NULL, "write");
         return -1;
     }
@@ -338,11 +334,9 @@ static int put(sink *s, const void *data, size_t n)
 
 static int pad_to(sink *s, uint64_t target)
 {
-    static const unsigned char zero[OCT_ALIGN];
-    while (s->bytes < target) {
-        uint64_t n = target - s->bytes;
-        if (put(s, zero, n < sizeof zero ? (size_t)n : sizeof zero) != 0)
-            return -1;
+    if (oct_sink_pad_to(&s->out, target) != 0) {
+        io_fail(s->m, NULL, "write");
+        return -1;
     }
     return 0;
 }
@@ -517,7 +511,7 @@ static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *t
     const int v11 = rd_u32le(m->head + OCT_OFF_FLAGS) != 0 || size[OCT_SEC_FUNCTION] != 0;
     const uint32_t hsize = v11 ? OCT_HEADER_SIZE_1_1 : OCT_HEADER_SIZE;
     const int nsec = v11 ? OCT_SEC_COUNT : OCT_SEC_COUNT_1_0;
-    sink s = {m, f, 0, 0};
+    sink s = {m, {f, 0, 0}};
     static const unsigned char zero[OCT_HEADER_SIZE_1_1];
     if (put(&s, zero, hsize) != 0)
         return OCT_EIO;
@@ -525,10 +519,10 @@ static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *t
     for (int k = 0; k < nsec && r == OCT_OK; k++) {
         if (!size[k])
             continue;
-        off[k] = oct_align_up(s.bytes);
+        off[k] = oct_align_up(s.out.bytes);
         if (pad_to(&s, off[k]) != 0)
             return OCT_EIO;
-        s.crc = crc32_z(0, NULL, 0);
+        s.out.crc = crc32_z(0, NULL, 0);
         if (k == OCT_SEC_LEVELS) {
             for (unsigned d = 0; d < m->levels && r == OCT_OK; d++) {
                 unsigned char b[8];
@@ -543,11 +537,11 @@ static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *t
             uLong ignored = 0;
             r = read_range(m, &m->parts[0], m->parts[0].off[k], size[k], &ignored, put_sink, &s);
         }
-        crc[k] = (uint32_t)s.crc;
+        crc[k] = (uint32_t)s.out.crc;
     }
     if (r != OCT_OK)
         return r;
-    *bytes = s.bytes;
+    *bytes = s.out.bytes;
 
     /* The parts' header up to the section table (identity, grid, surface
      * count: equal in every part), then the whole's own fields. */

@@ -2,6 +2,7 @@
  * deterministic serialization (bases and CRCs computed at finish). */
 #include "format/oct.h"
 #include "format/oct_layout.h"
+#include "format/oct_sink.h"
 
 #include <errno.h>
 #include <math.h>
@@ -21,41 +22,6 @@ struct oct_writer {
     int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
     int done; /* finish was called: the writer accepts nothing more */
 };
-
-/* Everything written goes through a sink: it always updates the running
- * CRC-32 and writes to `f` when there is one. */
-typedef struct sink {
-    FILE *f;
-    uLong crc;
-    uint64_t bytes;
-} sink;
-
-static int put(sink *s, const void *data, size_t n)
-{
-    if (n == 0)
-        return 0;
-    s->crc = crc32_z(s->crc, data, n);
-    s->bytes += n;
-    /* glibc may report a failed flush inside fwrite only through the error
-     * flag, so both are checked: the writer stops at the first failure. */
-    if (s->f && (fwrite(data, 1, n, s->f) != n || ferror(s->f))) {
-        if (errno == 0)
-            errno = EIO;
-        return -1;
-    }
-    return 0;
-}
-
-static int pad_to(sink *s, uint64_t target)
-{
-    static const unsigned char zero[OCT_ALIGN];
-    while (s->bytes < target) {
-        uint64_t n = target - s->bytes;
-        if (put(s, zero, n < sizeof zero ? (size_t)n : sizeof zero) != 0)
-            return -1;
-    }
-    return 0;
-}
 
 static int grow(void **buf, size_t *cap, size_t need, size_t elem)
 {
@@ -194,7 +160,7 @@ oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8
 static uint64_t groups_of(uint64_t nodes) { return nodes / 8 + (nodes % 8 != 0); }
 
 /* Streams the node section (every depth's groups, depth 0 first). */
-static int put_nodes(const oct_writer *w, sink *s)
+static int put_nodes(const oct_writer *w, oct_sink *s)
 {
     enum { CHUNK = 4096 };
     unsigned char buf[CHUNK * 16];
@@ -210,12 +176,12 @@ static int put_nodes(const oct_writer *w, sink *s)
                 base += oct_popcount64(rec[8 + k]);
             }
             if (++fill == CHUNK) {
-                if (put(s, buf, sizeof buf) != 0)
+                if (oct_sink_put(s, buf, sizeof buf) != 0)
                     return -1;
                 fill = 0;
             }
         }
-        if (put(s, buf, 16 * fill) != 0)
+        if (oct_sink_put(s, buf, 16 * fill) != 0)
             return -1;
     }
     return 0;
@@ -228,27 +194,27 @@ typedef struct layout {
 } layout;
 
 /* Writes (s->f != NULL) or checksums (s->f == NULL) section k. */
-static int put_section(const oct_writer *w, int k, sink *s)
+static int put_section(const oct_writer *w, int k, oct_sink *s)
 {
     switch (k) {
     case OCT_SEC_LEVELS:
         for (uint32_t d = 0; d < w->p.levels; d++) {
             unsigned char b[8];
             wr_u64le(b, w->count[d]);
-            if (put(s, b, 8) != 0)
+            if (oct_sink_put(s, b, 8) != 0)
                 return -1;
         }
         return 0;
     case OCT_SEC_NODES:
         return put_nodes(w, s);
     case OCT_SEC_VOXELS: /* little-endian host; nothing with OCT_FLAG_SHELL_ONLY */
-        return w->voxels ? put(s, w->voxels, w->voxel_count * sizeof(uint32_t)) : 0;
+        return w->voxels ? oct_sink_put(s, w->voxels, w->voxel_count * sizeof(uint32_t)) : 0;
     case OCT_SEC_SURFACES:
-        return w->p.surface_count > 1 ? put(s, w->surfaces, w->voxel_count) : 0;
+        return w->p.surface_count > 1 ? oct_sink_put(s, w->surfaces, w->voxel_count) : 0;
     case OCT_SEC_PALETTE:
-        return put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
+        return oct_sink_put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
     default:
-        return w->function ? put(s, w->function, w->p.function_size) : 0;
+        return w->function ? oct_sink_put(s, w->function, w->p.function_size) : 0;
     }
 }
 
@@ -337,7 +303,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             lay.off[k] = oct_align_up(end);
             end = lay.off[k] + size;
         }
-        sink crc = {NULL, crc32_z(0, NULL, 0), 0};
+        oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0};
         put_section(w, k, &crc);
         lay.crc[k] = (uint32_t)crc.crc;
     }
@@ -345,14 +311,14 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
 
     unsigned char h[OCT_HEADER_SIZE_1_1];
     build_header(w, &lay, h, hsize);
-    sink s = {f, 0, 0};
+    oct_sink s = {f, 0, 0};
     errno = 0;
-    if (put(&s, h, hsize) != 0)
+    if (oct_sink_put(&s, h, hsize) != 0)
         return OCT_EIO;
     for (int k = 0; k < nsec; k++) {
         if (lay.size[k] == 0)
             continue;
-        if (pad_to(&s, lay.off[k]) != 0 || put_section(w, k, &s) != 0)
+        if (oct_sink_pad_to(&s, lay.off[k]) != 0 || put_section(w, k, &s) != 0)
             return OCT_EIO;
     }
     if (fflush(f) != 0 || ferror(f)) {
