@@ -92,6 +92,7 @@ typedef struct trace_eye {
     double n, scale;  /* N = 2^L, N / edge */
     uint32_t nvox;
     int inside[3];    /* 0 <= o_a <= N */
+    int all_inside;   /* all three */
     int ok;
 } trace_eye;
 
