@@ -13,6 +13,7 @@
 
 #include "common/test_hooks.h"
 #include "common/view/image.h"
+#include "format/oct_normal.h"
 #include "render/ao.h"
 #include "render/beam.h"
 #include "render/map_guard.h"
@@ -105,7 +106,12 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
                         unsigned ao_count, unsigned ao_total, float rgb[3], float n[3])
 {
     const frame_job *job = sh->job;
-    double lam = shade_normal(job->tree, &job->shade, h, dir, n);
+    float ns[3]; /* a voxel hit's stored normal, decoded once for both uses */
+    const int stored = h->hit && !h->exact;
+    if (stored)
+        oct_normal_decode(job->tree->voxels[h->voxel] & OCT_VOXEL_NORMAL_MASK, ns);
+    double lam = stored ? shade_normal_stored(&job->shade, ns, dir, n)
+                        : shade_normal(job->tree, &job->shade, h, dir, n);
     float ao = 1.0f;
     const int shadow = job->shade.shadows && lam > 0.0;
     if (h->hit && (shadow || ao_count)) {
@@ -116,20 +122,20 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
         double p[3];
         for (int a = 0; a < 3; a++)
             p[a] = job->cam->eye[a] + h->t * dir[a];
-        shadow_start st;
-        if (!(h->exact ? shadow_start_at(job->tree, p, n, &st)
-                       : shadow_start_hit(job->tree, h, n, &st)))
+        shadow_start *const st = &acc->start;
+        if (!(h->exact ? shadow_start_at(job->tree, p, n, st)
+                       : shadow_start_stored(job->tree, h, ns, n, st)))
             goto lit; /* no start off the surface: lit and open */
         if (shadow) {
             acc->shadow_rays++;
-            if (shadow_blocked_from(job->tree, &job->opts, sh->traverse, &st, job->shade.light,
+            if (shadow_blocked_from(job->tree, &job->opts, sh->traverse, st, job->shade.light,
                                     INFINITY, &acc->secondary_steps))
                 lam = 0.0;
             if (job->timing)
                 t1 = frame_now_ns();
         }
         if (ao_count) {
-            ao = ao_factor_from(job->tree, &job->opts, sh->traverse, &st, n, ao_k0, ao_count,
+            ao = ao_factor_from(job->tree, &job->opts, sh->traverse, st, n, ao_k0, ao_count,
                                 ao_total, ao_seed(i, j), &acc->secondary_steps);
             acc->ao_rays += ao_count;
         }

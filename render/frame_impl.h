@@ -6,12 +6,15 @@
 #include <stdint.h>
 
 #include "render/frame.h"
+#include "render/shadow.h"
 
 /* What a thread adds up. */
 typedef struct frame_acc {
     uint64_t rays, hits, steps, aa_pixels, aa_full, shadow_rays, ao_rays, secondary_steps;
     uint64_t marked; /* sub-blocks marked by the beam's edge trigger */
     double shadow_ns, ao_ns;
+    shadow_start start; /* the last hit's secondary start: its anchor is the
+                           next one's search hint (start.near) */
 } frame_acc;
 
 typedef struct frame_sync frame_sync; /* frame.c's */

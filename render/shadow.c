@@ -14,13 +14,15 @@ double shadow_offset(const float n[3])
  * its grid position when computed back from the world point. */
 #define START_MARGIN 0x1p-10
 
-/* 1 when the voxel holding grid point g is known occupied; *an gets the
- * deepest occupied cell holding the box g +- START_MARGIN. */
-static int voxel_occupied(const oct_tree *tree, const double g[3], trace_anchor *an)
+/* 1 when the voxel holding grid point g is known occupied; s->anchor gets
+ * the deepest occupied cell holding the box g +- START_MARGIN. */
+static int voxel_occupied(const oct_tree *tree, const double g[3], shadow_start *s)
 {
     const double m = START_MARGIN;
     const double lo[3] = {g[0] - m, g[1] - m, g[2] - m}, hi[3] = {g[0] + m, g[1] + m, g[2] + m};
-    trace_anchor_find(tree, lo, hi, an);
+    trace_anchor *an = &s->anchor;
+    trace_anchor_find_near(tree, lo, hi, s->near ? an : NULL, an);
+    s->near = 1;
     if (an->depth + 1 != tree->levels)
         return 0; /* an empty cell above the voxels, outside the cube, or a box on a face */
     const unsigned c = ((uint32_t)lo[0] & 1u) | ((uint32_t)lo[1] & 1u) << 1 |
@@ -41,7 +43,7 @@ static int start_from(const oct_tree *tree, const double base[3], const float n[
         const double h = shadow_offset(n) + (double)k;
         for (int a = 0; a < 3; a++)
             g[a] = base[a] + h * (double)n[a];
-        if (!voxel_occupied(tree, g, &s->anchor)) {
+        if (!voxel_occupied(tree, g, s)) {
             for (int a = 0; a < 3; a++)
                 s->o[a] = tree->origin[a] + g[a] * vox;
             trace_eye_init(tree, s->o, &s->eye);
@@ -53,9 +55,15 @@ static int start_from(const oct_tree *tree, const double base[3], const float n[
 
 int shadow_start_hit(const oct_tree *tree, const trace_hit *hit, const float n[3], shadow_start *s)
 {
-    const uint32_t rec = tree->voxels[hit->voxel];
     float ns[3]; /* the stored normal: the plane's, n or -n */
-    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, ns);
+    oct_normal_decode(tree->voxels[hit->voxel] & OCT_VOXEL_NORMAL_MASK, ns);
+    return shadow_start_stored(tree, hit, ns, n, s);
+}
+
+int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                        const float n[3], shadow_start *s)
+{
+    const uint32_t rec = tree->voxels[hit->voxel];
     const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
     double base[3];
     for (int a = 0; a < 3; a++)
@@ -75,6 +83,7 @@ int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], s
 int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])
 {
     shadow_start s;
+    s.near = 0;
     const int ok = shadow_start_hit(tree, hit, n, &s);
     for (int a = 0; ok && a < 3; a++)
         o[a] = s.o[a];
@@ -84,6 +93,7 @@ int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], 
 int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], double o[3])
 {
     shadow_start s;
+    s.near = 0;
     const int ok = shadow_start_at(tree, p, n, &s);
     for (int a = 0; ok && a < 3; a++)
         o[a] = s.o[a];

@@ -58,10 +58,17 @@ typedef struct shadow_start {
     double o[3];
     trace_eye eye;       /* eye.ok = 0: no ray from o can be set up */
     trace_anchor anchor;
+    int near;            /* in and out: 1 when anchor holds an earlier start's
+                            anchor (same tree), which speeds the next search
+                            up (trace_anchor_find_near); 0 the first time */
 } shadow_start;
 
-/* shadow_origin and shadow_origin_at, with the shared part in *s. */
+/* shadow_origin and shadow_origin_at, with the shared part in *s (set
+ * s->near first). */
 int shadow_start_hit(const oct_tree *tree, const trace_hit *hit, const float n[3], shadow_start *s);
+/* shadow_start_hit with the hit voxel's stored normal ns already decoded. */
+int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                        const float n[3], shadow_start *s);
 int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s);
 
 /* 1 when the ray o + t d (d unit), 0 <= t <= t_max (+inf allowed), meets an

@@ -216,10 +216,18 @@ int trace_clip(trace_ray *r, double t_lo, double t_hi)
     return r->t_start < r->t_end;
 }
 
-void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
-                       trace_anchor *a)
+/* trace_anchor_find, the nodes down to the deepest cell the box shares
+ * with `near`'s (a result of this search on the same tree, or NULL) taken
+ * from near instead of the tree: the same nodes, as the search from the
+ * root passes them. a may be near. */
+static void anchor_search(const oct_tree *tree, const double lo[3], const double hi[3],
+                          const trace_anchor *near, trace_anchor *a)
 {
     const unsigned levels = tree->levels;
+    const unsigned pd = near ? near->depth : 0;
+    uint32_t pc[3] = {0, 0, 0};
+    for (int i = 0; pd && i < 3; i++)
+        pc[i] = near->cell[i];
     a->depth = 0;
     a->cell[0] = a->cell[1] = a->cell[2] = 0;
     if (tree->node_count[0] == 0 || levels < 1 || levels > OCT_MAX_LEVELS)
@@ -234,10 +242,11 @@ void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi
     /* whole voxels: the box lies in voxels [vl, vh]; it straddles two
      * cells of depth d exactly when vl ^ vh has a bit at levels - d or
      * above, so the deepest depth it can reach is known at once */
-    uint32_t vl[3], diff = 0;
+    uint32_t vl[3], diff = 0, off = 0;
     for (int i = 0; i < 3; i++) {
         vl[i] = (uint32_t)lo[i];
         diff |= vl[i] ^ (uint32_t)hi[i];
+        off |= vl[i] ^ pc[i];
     }
     unsigned dmax = levels - 1;
     if (diff) {
@@ -246,7 +255,18 @@ void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi
             return; /* it straddles two children of the root */
         dmax = levels - bits < dmax ? levels - bits : dmax;
     }
-    unsigned d = 1;
+    /* near's cell of depth d <= pd holds the box's when vl and its corner
+     * agree above bit levels - d */
+    unsigned d0 = pd < dmax ? pd : dmax;
+    if (off) {
+        const unsigned bits = 32u - (unsigned)__builtin_clz(off);
+        const unsigned common = bits >= levels ? 0 : levels - bits;
+        d0 = common < d0 ? common : d0;
+    }
+    if (a != near)
+        for (unsigned d = 1; d <= d0; d++)
+            a->node[d] = near->node[d];
+    unsigned d = d0 + 1;
     for (; d <= dmax; d++) {
         const unsigned sh = levels - d;
         const unsigned c = (vl[0] >> sh & 1u) | (vl[1] >> sh & 1u) << 1 | (vl[2] >> sh & 1u) << 2;
@@ -263,4 +283,16 @@ void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi
     const unsigned sh = levels - a->depth;
     for (int i = 0; a->depth && i < 3; i++)
         a->cell[i] = vl[i] >> sh << sh;
+}
+
+void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
+                       trace_anchor *a)
+{
+    anchor_search(tree, lo, hi, NULL, a);
+}
+
+void trace_anchor_find_near(const oct_tree *tree, const double lo[3], const double hi[3],
+                            const trace_anchor *near, trace_anchor *a)
+{
+    anchor_search(tree, lo, hi, near, a);
 }

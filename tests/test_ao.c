@@ -184,6 +184,8 @@ static void test_shared_start_same_answers(void **state)
     const double eye[3] = {150, 110, 120};
     static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5}};
     unsigned long checked = 0, deep = 0, blocked = 0, shaded = 0;
+    shadow_start st; /* kept from hit to hit: each start's search starts near the last */
+    st.near = 0;
     for (unsigned impl = 0; impl < trace_impl_count; impl++)
         for (int refine = 0; refine <= 1; refine++) {
             const trace_opts o = {.split = LEVELS, .refine = refine};
@@ -203,7 +205,6 @@ static void test_shared_start_same_answers(void **state)
                         for (int a = 0; a < 3; a++)
                             n[a] = -n[a];
                     double org[3];
-                    shadow_start st;
                     const int ok = shadow_origin(t, &h, n, org);
                     assert_int_equal(shadow_start_hit(t, &h, n, &st), ok);
                     if (!ok)

@@ -1,6 +1,7 @@
 /* Tests for render/trace_setup's shortcuts: trace_setup_eye from an eye
  * inside the root cube against its general path, and trace_anchor_find
- * against the plain per-level search, bit for bit. */
+ * (from the root or near an earlier anchor) against the plain per-level
+ * search, bit for bit. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -90,8 +91,10 @@ static void test_setup_inside_same_ray(void **state)
     assert_true(set > 10000 && same > set);
 }
 
-/* trace_anchor_find against the plain per-level search it replaces: the
- * same depth, corner and nodes for boxes anywhere, small and large. */
+/* trace_anchor_find against the plain per-level search it replaces, and
+ * trace_anchor_find_near from the previous box's anchor: the same depth,
+ * corner and nodes for boxes anywhere, small and large, near the last one
+ * or not. */
 static void ref_anchor(const oct_tree *tree, const double lo[3], const double hi[3],
                        trace_anchor *a)
 {
@@ -133,7 +136,7 @@ static void ref_anchor(const oct_tree *tree, const double lo[3], const double hi
 static void test_anchor_find_reference(void **state)
 {
     (void)state;
-    unsigned long boxes = 0, deep = 0;
+    unsigned long boxes = 0, deep = 0, shared = 0;
     for (int tr = 0; tr < 16; tr++) {
         const unsigned L = 1 + irand(8);
         const uint32_t N = 1u << L;
@@ -143,27 +146,52 @@ static void test_anchor_find_reference(void **state)
         const size_t m = random_voxels(n, N / 8, N - N / 8 > 0 ? N - N / 8 : 1, xyz);
         oct_tree *t = tree_util_simple(L, (const uint32_t(*)[3])xyz, m);
         assert_non_null(t);
+        trace_anchor last;
+        last.depth = 0;
+        double nlo[3], nhi[3];
+        int near_next = 0;
         for (int k = 0; k < 3000; k++) {
             double lo[3], hi[3];
             const double w = irand(2) ? 0x1p-9 : urand() * (double)N / (double)(1u << irand(L + 1));
             for (int a = 0; a < 3; a++) {
-                lo[a] = urand() * (N + 2.0) - 1.0;
-                hi[a] = lo[a] + (irand(8) ? w : -w);
+                lo[a] = near_next ? nlo[a] : urand() * (N + 2.0) - 1.0;
+                hi[a] = near_next ? nhi[a] : lo[a] + (irand(8) ? w : -w);
             }
-            trace_anchor a0, a1;
+            near_next = 0;
+            trace_anchor a0, a1, a2;
             ref_anchor(t, lo, hi, &a0);
             trace_anchor_find(t, lo, hi, &a1);
             assert_int_equal(a1.depth, a0.depth);
             assert_memory_equal(a1.cell, a0.cell, sizeof a0.cell);
             assert_memory_equal(a1.node, a0.node, (a0.depth + 1) * sizeof a0.node[0]);
+            /* from the last box's anchor (near or far from this one), into
+               another struct and in place */
+            trace_anchor_find_near(t, lo, hi, &last, &a2);
+            assert_int_equal(a2.depth, a0.depth);
+            assert_memory_equal(a2.cell, a0.cell, sizeof a0.cell);
+            assert_memory_equal(a2.node, a0.node, (a0.depth + 1) * sizeof a0.node[0]);
+            shared += last.depth > 0 && a0.depth > 0 && a0.node[1].ci == last.node[1].ci;
+            trace_anchor_find_near(t, lo, hi, &last, &last);
+            assert_int_equal(last.depth, a0.depth);
+            assert_memory_equal(last.cell, a0.cell, sizeof a0.cell);
+            assert_memory_equal(last.node, a0.node, (a0.depth + 1) * sizeof a0.node[0]);
+            if (irand(3) == 0) { /* the next box next to this one */
+                for (int a = 0; a < 3; a++) {
+                    nlo[a] = lo[a] + (urand() - 0.5) * 4.0;
+                    nhi[a] = nlo[a] + 0x1p-9;
+                }
+                near_next = 1;
+            }
             boxes++;
             deep += a0.depth + 1 >= L && L > 1;
         }
         tree_util_free(t);
         free(xyz);
     }
-    print_message("anchors: %lu boxes the same, %lu down to the voxels' parents\n", boxes, deep);
-    assert_true(deep > 100);
+    print_message("anchors: %lu boxes the same, from the root and from the last box's anchor "
+                  "(%lu sharing nodes with it), %lu down to the voxels' parents\n",
+                  boxes, shared, deep);
+    assert_true(deep > 100 && shared > 1000);
 }
 
 int main(void)
