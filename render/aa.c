@@ -22,6 +22,8 @@ int aa_differs(const aa_probe *a, const aa_probe *b)
 int aa_needs(const aa_probe *probes, uint32_t w, uint32_t h, uint32_t i, uint32_t j)
 {
     const aa_probe *p = &probes[(size_t)j * w + i];
+    if (p->beam_edge)
+        return 1;
     /* the common case, misses all round, without the calls */
     if (!p->hit && (i == 0 || !p[-1].hit) && (i + 1 >= w || !p[1].hit) &&
         (j == 0 || !p[-(ptrdiff_t)w].hit) && (j + 1 >= h || !p[w].hit))

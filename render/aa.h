@@ -21,13 +21,19 @@ typedef struct aa_probe {
     float n[3];
     uint16_t surface;
     uint8_t hit;
+    uint8_t beam_edge; /* its beam sub-block holds an edge (aa_needs) */
 } aa_probe;
 
 /* 1 when the centre rays a and b differ by the rule above. */
 int aa_differs(const aa_probe *a, const aa_probe *b);
 
 /* 1 when pixel (i, j) of the w x h probes (rows top to bottom) needs its
- * samples: it differs from a 4-neighbour inside the image. */
+ * samples: it differs from a 4-neighbour inside the image, or the beam
+ * pre-pass says its sub-block holds an edge (beam_edge): the sub-block's
+ * pyramid, which lies within its pixels' squares, may meet an occupied
+ * voxel (a finite start) but none of its centre rays hit one, so
+ * something lies between them that only samples can find. (A sub-block
+ * with hits holds its edges where the neighbour test finds them.) */
 int aa_needs(const aa_probe *probes, uint32_t w, uint32_t h, uint32_t i, uint32_t j);
 
 /* Offset of sample k (k < n * n) inside the pixel, in pixel units, each in

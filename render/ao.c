@@ -13,17 +13,27 @@ uint32_t ao_seed(uint32_t i, uint32_t j)
     return (uint32_t)((x ^ (x >> 31)) >> 32);
 }
 
-void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3])
+void ao_basis(const float n[3], ao_frame *f)
 {
-    double nn[3] = {n[0], n[1], n[2]};
+    double *nn = f->n;
+    for (int a = 0; a < 3; a++)
+        nn[a] = n[a];
     const double len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
     for (int a = 0; a < 3; a++)
         nn[a] /= len;
     /* an orthonormal basis t, b, nn (Duff et al. 2017, branchless) */
     const double sg = nn[2] >= 0.0 ? 1.0 : -1.0;
     const double ka = -1.0 / (sg + nn[2]), kb = nn[0] * nn[1] * ka;
-    const double t[3] = {1.0 + sg * nn[0] * nn[0] * ka, sg * kb, -sg * nn[0]};
-    const double b[3] = {kb, sg + nn[1] * nn[1] * ka, -nn[1]};
+    f->t[0] = 1.0 + sg * nn[0] * nn[0] * ka;
+    f->t[1] = sg * kb;
+    f->t[2] = -sg * nn[0];
+    f->b[0] = kb;
+    f->b[1] = sg + nn[1] * nn[1] * ka;
+    f->b[2] = -nn[1];
+}
+
+void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, uint32_t seed, double d[3])
+{
     const double u = ((double)k + 0.5) / (double)m;
     double turns = (double)k * 0.61803398874989484820 + (double)seed * 0x1p-32;
     turns -= floor(turns);
@@ -31,16 +41,48 @@ void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, doubl
     const double r = sqrt(u), c = sqrt(1.0 - u);
     const double x = r * cos(phi), y = r * sin(phi);
     for (int a = 0; a < 3; a++)
-        d[a] = x * t[a] + y * b[a] + c * nn[a];
+        d[a] = x * f->t[a] + y * f->b[a] + c * f->n[a];
+}
+
+void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3])
+{
+    ao_frame f;
+    ao_basis(n, &f);
+    ao_direction_in(&f, k, m, seed, d);
+}
+
+/* The unoccluded fraction of the rays k0 .. k0 + count - 1 from the grid
+ * position e, started at anchor an. */
+static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                           const trace_eye *e, const trace_anchor *an, const float n[3],
+                           unsigned k0, unsigned count, unsigned m, uint32_t seed, uint64_t *steps)
+{
+    const double dist = AO_DISTANCE * tree->edge;
+    if (!traverse)
+        traverse = trace_impls[0].traverse;
+    ao_frame f;
+    ao_basis(n, &f);
+    unsigned open = 0;
+    for (unsigned k = k0; k < k0 + count; k++) {
+        double d[3];
+        ao_direction_in(&f, k, m, seed, d);
+        trace_ray r;
+        if (!trace_setup_eye(e, d, &r) || !trace_clip(&r, 0.0, dist)) {
+            open++;
+            continue;
+        }
+        trace_hit h;
+        traverse(tree, opts, &r, an, &h);
+        *steps += h.steps;
+        open += !h.hit;
+    }
+    return (float)open / (float)count;
 }
 
 float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                 const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
                 uint32_t seed, uint64_t *steps)
 {
-    const double dist = AO_DISTANCE * tree->edge;
-    if (!traverse)
-        traverse = trace_impls[0].traverse;
     /* the rays share their start: its grid position once, and the deepest
        occupied cell around it, where every ray's descent would arrive */
     trace_eye e;
@@ -57,19 +99,14 @@ float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn 
         }
         trace_anchor_find(tree, lo, hi, &an);
     }
-    unsigned open = 0;
-    for (unsigned k = k0; k < k0 + count; k++) {
-        double d[3];
-        ao_direction(n, k, m, seed, d);
-        trace_ray r;
-        if (!trace_setup_eye(&e, d, &r) || !trace_clip(&r, 0.0, dist)) {
-            open++;
-            continue;
-        }
-        trace_hit h;
-        traverse(tree, opts, &r, &an, &h);
-        *steps += h.steps;
-        open += !h.hit;
-    }
-    return (float)open / (float)count;
+    return open_fraction(tree, opts, traverse, &e, &an, n, k0, count, m, seed, steps);
+}
+
+float ao_factor_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                     const shadow_start *s, const float n[3], unsigned k0, unsigned count,
+                     unsigned m, uint32_t seed, uint64_t *steps)
+{
+    if (!s->eye.ok)
+        return 1.0f;
+    return open_fraction(tree, opts, traverse, &s->eye, &s->anchor, n, k0, count, m, seed, steps);
 }

@@ -28,11 +28,28 @@ uint32_t ao_seed(uint32_t i, uint32_t j);
  * `seed`, in d[3] (unit). */
 void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3]);
 
+/* ao_direction in two parts: the hemisphere's frame for n once
+ * (ao_basis), then each ray in it (ao_direction_in): the same operations
+ * on the same values, so the same bits. */
+typedef struct ao_frame {
+    double t[3], b[3], n[3];
+} ao_frame;
+void ao_basis(const float n[3], ao_frame *f);
+void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, uint32_t seed, double d[3]);
+
 /* The unoccluded fraction of rays k0 .. k0 + count - 1 of M from the world
  * point o (shadow_origin's) over unit n: (rays meeting nothing) / count,
  * count >= 1. Adds the rays' DDA steps to *steps. */
 float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                 const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
                 uint32_t seed, uint64_t *steps);
+
+struct shadow_start; /* render/shadow.h */
+
+/* ao_factor from a hit's shared start (shadow_start_hit's), its rays
+ * started at its anchor: the same factor and steps. */
+float ao_factor_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                     const struct shadow_start *s, const float n[3], unsigned k0, unsigned count,
+                     unsigned m, uint32_t seed, uint64_t *steps);
 
 #endif

@@ -4,15 +4,21 @@
 #include <math.h>
 
 typedef struct beam_block {
-    double u0, u1, v0, v1; /* camera_u / camera_v of the block's extreme pixel centres */
+    double u0, u1, v0, v1; /* the block's outer pixel edges in camera (u, v) */
 } beam_block;
 
+/* The block's pyramid is bounded by its pixels' outer edges (camera_u's
+ * formula at i0 and i1, not at the pixel centres i0 + 1/2 and i1 - 1/2), so
+ * that every sub-block's pyramid holds its pixels' whole squares, where the
+ * antialiasing samples lie. */
 static beam_block beam_block_of(const camera *cam, uint32_t i0, uint32_t i1, uint32_t j0,
                                 uint32_t j1)
 {
+    const double w = (double)cam->width, h = (double)cam->height;
     /* u grows with i, v falls with j */
-    beam_block b = {camera_u(cam, i0), camera_u(cam, i1 - 1), camera_v(cam, j1 - 1),
-                    camera_v(cam, j0)};
+    beam_block b = {(2.0 * (double)i0 / w - 1.0) * cam->h * w / h,
+                    (2.0 * (double)i1 / w - 1.0) * cam->h * w / h,
+                    (1.0 - 2.0 * (double)j1 / h) * cam->h, (1.0 - 2.0 * (double)j0 / h) * cam->h};
     return b;
 }
 
@@ -287,13 +293,20 @@ int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i
 void beam_start_box(const camera *cam, const double o[3], double scale, uint32_t i0, uint32_t i1,
                     uint32_t j0, uint32_t j1, double t, double lo[3], double hi[3])
 {
+    beam_start_box_uv(cam, o, scale, camera_u(cam, i0), camera_u(cam, i1 - 1), camera_v(cam, j1 - 1),
+                      camera_v(cam, j0), t, lo, hi);
+}
+
+void beam_start_box_uv(const camera *cam, const double o[3], double scale, double u0, double u1,
+                       double v0, double v1, double t, double lo[3], double hi[3])
+{
     /* A ray's unit direction is w / |w|, w = F + uR + vU, with |w|^2 =
      * 1 + u^2 + v^2 within basis_slack; w lies in the hull of the four
      * corner pixels' w and |w| between its least and greatest over the
      * block, so the point lies in the hull of the corners' w scaled by t
      * over both extremes of |w|. */
-    const double u[2] = {camera_u(cam, i0), camera_u(cam, i1 - 1)};
-    const double v[2] = {camera_v(cam, j1 - 1), camera_v(cam, j0)};
+    const double u[2] = {u0, u1};
+    const double v[2] = {v0, v1};
     const double u_in = u[0] <= 0.0 && u[1] >= 0.0 ? 0.0 : fmin(u[0] * u[0], u[1] * u[1]);
     const double v_in = v[0] <= 0.0 && v[1] >= 0.0 ? 0.0 : fmin(v[0] * v[0], v[1] * v[1]);
     const double u_out = fmax(u[0] * u[0], u[1] * u[1]), v_out = fmax(v[0] * v[0], v[1] * v[1]);

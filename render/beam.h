@@ -1,6 +1,7 @@
-/* beam: ray coherence for a block of pixels. The rays through the centres of
- * a block of pixels all lie in one pyramid with its apex at the eye, and
- * those of each of its sub-blocks in a smaller one. One walk of the octree
+/* beam: ray coherence for a block of pixels. The rays through the squares
+ * of a block of pixels (centre rays and antialiasing samples) all lie in one
+ * pyramid with its apex at the eye, bounded by the block's outer pixel
+ * edges, and those of each of its sub-blocks in a smaller one. One walk of the octree
  * finds, for every sub-block, the nearest distance at which its pyramid may
  * touch an occupied voxel: before that t_lo no ray of the sub-block can meet
  * one. The frame then traces each ray from its t_lo only (trace_clip); a
@@ -52,5 +53,10 @@ int beam_starts(const oct_tree *tree, const camera *cam, uint32_t i0, uint32_t i
  * computes them. For trace_anchor_find. */
 void beam_start_box(const camera *cam, const double o[3], double scale, uint32_t i0, uint32_t i1,
                     uint32_t j0, uint32_t j1, double t, double lo[3], double hi[3]);
+
+/* The same for the rays whose camera (u, v) lie in [u0, u1] x [v0, v1]
+ * (u0 <= u1, v0 <= v1; beam_start_box's rectangle is its pixel centres'). */
+void beam_start_box_uv(const camera *cam, const double o[3], double scale, double u0, double u1,
+                       double v0, double v1, double t, double lo[3], double hi[3]);
 
 #endif

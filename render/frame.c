@@ -1,5 +1,6 @@
 /* frame: multi-threaded tile renderer for one view. */
 #include "render/frame.h"
+#include "render/frame_impl.h"
 
 #include <errno.h>
 #include <float.h>
@@ -12,16 +13,11 @@
 
 #include "common/test_hooks.h"
 #include "common/view/image.h"
+#include "format/oct_normal.h"
 #include "render/ao.h"
 #include "render/beam.h"
 #include "render/map_guard.h"
 #include "render/shadow.h"
-
-/* What a thread adds up. */
-typedef struct frame_acc {
-    uint64_t rays, hits, steps, aa_pixels, aa_full, shadow_rays, ao_rays, secondary_steps;
-    double secondary_ns;
-} frame_acc;
 
 /* What the threads of a frame share and change. */
 typedef struct frame_sync {
@@ -29,23 +25,13 @@ typedef struct frame_sync {
     atomic_int changed; /* set when map_guard abandoned a thread's work */
     pthread_mutex_t lock; /* guards the sums below */
     frame_acc sum;
-    double thread_ns;
+    double pass_ns[2]; /* thread time of each pass, secondary rays left out */
     exact_worker *exact; /* with --exact: one per thread of a pass, else NULL */
     atomic_uint next_exact;
 } frame_sync;
 
-/* What a thread reads while it renders: one per thread (a copy), so that
- * with --exact its job carries that thread's own exact worker. */
-typedef struct frame_shared {
-    const frame_job *job;
-    trace_traverse_fn traverse;
-    aa_probe *probes; /* centre rays, for the antialiasing pass; NULL without */
-    int phase;        /* 0: centre rays; 1: samples where needed */
-    uint32_t tiles_x, tiles_y;
-    frame_sync *sync;
-} frame_shared;
 
-static double now_ns(void)
+double frame_now_ns(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -107,38 +93,64 @@ uint8_t frame_srgb8(float x)
     return srgb8_fast(x);
 }
 
+uint8_t frame_srgb8_ready(float x)
+{
+    return srgb8_fast(x);
+}
+
 /* Shades a traced sample of pixel (i, j) seen along `dir`: the shadow ray,
  * AO rays k0 .. k0 + ao_count - 1 of ao_total, the colour; n gets the
  * facing normal. */
-static void shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit *h,
-                         const double dir[3], uint32_t i, uint32_t j, unsigned ao_k0,
-                         unsigned ao_count, unsigned ao_total, float rgb[3], float n[3])
+void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit *h,
+                        const double dir[3], uint32_t i, uint32_t j, unsigned ao_k0,
+                        unsigned ao_count, unsigned ao_total, float rgb[3], float n[3])
 {
     const frame_job *job = sh->job;
-    double lam = shade_normal(job->tree, &job->shade, h, dir, n);
+    float ns[3]; /* a voxel hit's stored normal, decoded once for both uses */
+    const int stored = h->hit && !h->exact;
+    if (stored)
+        oct_normal_decode(job->tree->voxels[h->voxel] & OCT_VOXEL_NORMAL_MASK, ns);
+    double lam = stored ? shade_normal_stored(&job->shade, ns, dir, n)
+                        : shade_normal(job->tree, &job->shade, h, dir, n);
     float ao = 1.0f;
     const int shadow = job->shade.shadows && lam > 0.0;
     if (h->hit && (shadow || ao_count)) {
-        const double t0 = job->timing ? now_ns() : 0.0;
-        double o[3], p[3];
+        /* timed per kind: the shared start goes to the shadow ray when
+           there is one */
+        const double t0 = job->timing ? frame_now_ns() : 0.0;
+        double t1 = t0;
+        double p[3];
         for (int a = 0; a < 3; a++)
             p[a] = job->cam->eye[a] + h->t * dir[a];
-        if (!(h->exact ? shadow_origin_at(job->tree, p, n, o) : shadow_origin(job->tree, h, n, o)))
+        shadow_start *const st = &acc->start;
+        if (!(h->exact ? shadow_start_at(job->tree, p, n, st)
+                       : shadow_start_stored(job->tree, h, ns, n, st)))
             goto lit; /* no start off the surface: lit and open */
         if (shadow) {
             acc->shadow_rays++;
-            if (shadow_blocked(job->tree, &job->opts, sh->traverse, o, job->shade.light,
-                               INFINITY, &acc->secondary_steps))
+            if (shadow_blocked_from(job->tree, &job->opts, sh->traverse, st, job->shade.light,
+                                    INFINITY, &acc->secondary_steps))
                 lam = 0.0;
+            if (job->timing)
+                t1 = frame_now_ns();
         }
         if (ao_count) {
-            ao = ao_factor(job->tree, &job->opts, sh->traverse, o, n, ao_k0, ao_count, ao_total,
-                           ao_seed(i, j), &acc->secondary_steps);
+            ao = ao_factor_from(job->tree, &job->opts, sh->traverse, st, n, ao_k0, ao_count,
+                                ao_total, ao_seed(i, j), &acc->secondary_steps);
             acc->ao_rays += ao_count;
         }
     lit:
-        if (job->timing)
-            acc->secondary_ns += now_ns() - t0;
+        if (job->timing) {
+            const double t2 = frame_now_ns();
+            if (shadow) {
+                if (t1 == t0) /* no start: all of it the shadow's */
+                    t1 = t2;
+                acc->shadow_ns += t1 - t0;
+                acc->ao_ns += t2 - t1;
+            } else {
+                acc->ao_ns += t2 - t0;
+            }
+        }
     }
     if (!h->hit && job->alpha)
         rgb[0] = rgb[1] = rgb[2] = 0.0f;
@@ -162,7 +174,7 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
         h.steps = 0;
     }
     float rgb[3], n[3];
-    shade_sample(sh, acc, &h, dir, i, j, 0, job->shade.ao_rays, job->shade.ao_rays, rgb, n);
+    frame_shade_sample(sh, acc, &h, dir, i, j, 0, job->shade.ao_rays, job->shade.ao_rays, rgb, n);
     const size_t px = (size_t)j * job->cam->width + i;
     for (int a = 0; a < 3; a++)
         job->rgb[3 * px + (size_t)a] = srgb8_fast(rgb[a]);
@@ -180,6 +192,7 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
     if (sh->probes) {
         aa_probe *p = &sh->probes[px];
         p->hit = (uint8_t)h.hit;
+        p->beam_edge = 0;
         p->t = h.hit ? (float)h.t : INFINITY;
         p->surface = shade_surface(job->tree, &h);
         for (int a = 0; a < 3; a++)
@@ -191,6 +204,19 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
     }
     acc->hits += (uint64_t)h.hit;
     acc->steps += h.steps;
+}
+
+/* The beam's edge trigger (aa.h): a sub-block whose pyramid may meet an
+ * occupied voxel though none of its centre rays hit one holds something
+ * between them, so each of its pixels [i0, i1) x [j0, j1) is sampled. */
+static void mark_beam_edge(const frame_shared *sh, frame_acc *acc, uint32_t i0, uint32_t i1,
+                           uint32_t j0, uint32_t j1)
+{
+    const uint32_t w = sh->job->cam->width;
+    for (uint32_t j = j0; j < j1; j++)
+        for (uint32_t i = i0; i < i1; i++)
+            sh->probes[(size_t)j * w + i].beam_edge = 1;
+    acc->marked++;
 }
 
 /* The pixels [i0, i1) x [j0, j1): with the beam, each sub-block's rays are
@@ -260,6 +286,7 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
                                g.row[sr + 1], t_lo, lo, hi);
                 trace_anchor_find(job->tree, lo, hi, &an);
             }
+            const uint64_t hits0 = acc->hits;
             for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++) {
                 const double v = camera_v(cam, j);
                 for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++) {
@@ -271,134 +298,9 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
                     render_pixel(sh, acc, i, j, dir, traced ? &r : NULL, &an, t_lo);
                 }
             }
+            if (sh->probes && job->beam_size && !job->no_beam_edge && acc->hits == hits0)
+                mark_beam_edge(sh, acc, g.col[sc], g.col[sc + 1], g.row[sr], g.row[sr + 1]);
         }
-}
-
-/* The first pixel of the beam block holding pixel k along an axis of n
- * pixels, and its end. */
-static void block_span(const frame_job *job, uint32_t k, uint32_t n, uint32_t *k0, uint32_t *k1)
-{
-    const uint32_t bs = job->beam_size, t0 = k / FRAME_TILE * FRAME_TILE;
-    const uint32_t t1 = t0 + FRAME_TILE < n ? t0 + FRAME_TILE : n;
-    *k0 = t0 + (k - t0) / bs * bs;
-    *k1 = *k0 + bs < t1 ? *k0 + bs : t1;
-}
-
-/* Where the samples of pixel (i, j) may start (+inf: they all miss). Its
- * square lies within the centre rays of the 3 x 3 pixels around it; when
- * those are all in one beam block, their rays are in the block's pyramid,
- * which its sub-blocks' pyramids tile, so no sample meets an occupied voxel
- * before the least of those sub-blocks' starts (beam.h). Pixels at a
- * block's border, and --beam 0, start at the eye. */
-static double sample_start(const frame_shared *sh, uint32_t i, uint32_t j)
-{
-    const frame_job *job = sh->job;
-    const camera *cam = job->cam;
-    if (!job->beam_size)
-        return 0.0;
-    uint32_t i0, i1, j0, j1;
-    block_span(job, i, cam->width, &i0, &i1);
-    block_span(job, j, cam->height, &j0, &j1);
-    if (i < i0 + 1 || i + 2 > i1 || j < j0 + 1 || j + 2 > j1)
-        return 0.0;
-    float lo = INFINITY;
-    for (uint32_t y = j - 1; y <= j + 1; y++)
-        for (uint32_t x = i - 1; x <= i + 1; x++) {
-            const float t = sh->probes[(size_t)y * cam->width + x].t_lo;
-            lo = t < lo ? t : lo;
-        }
-    return lo;
-}
-
-/* Sample k of pixel (i, j) (aa.h's order), traced from t_lo and shaded
- * with AO rays k * per .. of per * N^2; its colour in rgb, what the edge
- * test keeps of it in p. */
-static void trace_sample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
-                         uint32_t j, unsigned k, double t_lo, unsigned per, float rgb[3],
-                         aa_probe *p)
-{
-    const frame_job *job = sh->job;
-    const camera *cam = job->cam;
-    const unsigned na = job->aa;
-    const double w = (double)cam->width, hh = (double)cam->height;
-    double fx, fy, dir[3];
-    aa_sample_offset(na, k, &fx, &fy);
-    const double u = (2.0 * ((double)i + fx) / w - 1.0) * cam->h * w / hh;
-    const double v = (1.0 - 2.0 * ((double)j + fy) / hh) * cam->h;
-    camera_ray_uv(cam, u, v, dir);
-    trace_ray r;
-    trace_hit h;
-    if (t_lo < INFINITY && trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY)) {
-        sh->traverse(job->tree, &job->opts, &r, NULL, &h);
-    } else {
-        h.hit = 0;
-        h.t = INFINITY;
-        h.steps = 0;
-    }
-    acc->rays++;
-    acc->steps += h.steps;
-    shade_sample(sh, acc, &h, dir, i, j, k * per, per, per * na * na, rgb, p->n);
-    p->hit = (uint8_t)h.hit;
-    p->t = h.hit ? (float)h.t : INFINITY;
-    p->surface = shade_surface(job->tree, &h);
-}
-
-/* Pixel (i, j) again with samples (aa.h): the four corner samples of the
- * N x N grid first; when they and the centre ray all agree by the edge
- * rule, the pixel holds no edge and they are its colour; otherwise all
- * N x N. Colours averaged in linear light; AO rays shared out. */
-static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
-                        uint32_t j)
-{
-    const frame_job *job = sh->job;
-    const camera *cam = job->cam;
-    const unsigned na = job->aa, ns = na * na, ao = job->shade.ao_rays;
-    const unsigned per = ao ? (ao / ns > 0 ? ao / ns : 1) : 0;
-    const size_t px = (size_t)j * cam->width + i;
-    const unsigned corner[4] = {0, na - 1, ns - na, ns - 1};
-    float sum[3] = {0.0f, 0.0f, 0.0f};
-    unsigned hits = 0, done = 0;
-    int uniform = 1;
-    const double t_lo = sample_start(sh, i, j);
-    for (unsigned k = 0; k < ns; k++) {
-        int is_corner = 0;
-        for (unsigned c = 0; c < 4; c++)
-            is_corner |= k == corner[c];
-        const int pass = done < 4 ? 0 : 1; /* corners, then the rest */
-        if (pass == 0 ? !is_corner : is_corner)
-            continue;
-        float rgb[3];
-        aa_probe p;
-        trace_sample(sh, acc, eye, i, j, k, t_lo, per, rgb, &p);
-        uniform &= !aa_differs(&p, &sh->probes[px]);
-        hits += p.hit;
-        if (p.hit || !job->alpha)
-            for (int a = 0; a < 3; a++)
-                sum[a] += rgb[a];
-        if (++done == 4) {
-            if (uniform)
-                break;
-            k = (unsigned)-1; /* the rest, from the start */
-        }
-    }
-    const float div = job->alpha ? (float)(hits ? hits : 1) : (float)done;
-    for (int a = 0; a < 3; a++)
-        job->rgb[3 * px + (size_t)a] = srgb8_fast(sum[a] / div);
-    if (job->alpha)
-        job->alpha[px] = (uint8_t)((hits * 255u + done / 2) / done);
-    acc->aa_pixels++;
-    acc->aa_full += done == ns;
-}
-
-/* The antialiasing pass over [i0, i1) x [j0, j1): samples where needed. */
-static void supersample_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye,
-                             uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
-{
-    const camera *cam = sh->job->cam;
-    for (uint32_t j = j0; j < j1; j++)
-        for (uint32_t i = i0; i < i1; i++)
-            if (aa_needs(sh->probes, cam->width, cam->height, i, j))
-                supersample(sh, acc, eye, i, j);
 }
 
 static void render_tile(const frame_shared *sh, frame_acc *acc, uint32_t tx, uint32_t ty)
@@ -412,16 +314,20 @@ static void render_tile(const frame_shared *sh, frame_acc *acc, uint32_t tx, uin
     double us[FRAME_TILE]; /* camera_u of column i0 + k */
     trace_eye eye;
     trace_eye_init(job->tree, cam->eye, &eye); /* eye.ok = 0: every ray misses */
+    uint8_t *any = sh->tile_any ? &sh->tile_any[(size_t)ty * sh->tiles_x + tx] : NULL;
     if (sh->phase == 1) {
-        supersample_tile(sh, acc, &eye, i0, i1, j0, j1);
+        frame_supersample_tile(sh, acc, &eye, *any, i0, i1, j0, j1);
         return;
     }
+    const uint64_t hits0 = acc->hits, marked0 = acc->marked;
     for (uint32_t i = i0; i < i1; i++)
         us[i - i0] = camera_u(cam, i);
     for (uint32_t bj = j0; bj < j1; bj += bs)
         for (uint32_t bi = i0; bi < i1; bi += bs)
             render_block(sh, acc, &eye, us, i0, bi, bi + bs < i1 ? bi + bs : i1, bj,
                          bj + bs < j1 ? bj + bs : j1);
+    if (any)
+        *any = acc->hits != hits0 || acc->marked != marked0;
 }
 
 static void work(const frame_shared *common, int caller)
@@ -438,7 +344,7 @@ static void work(const frame_shared *common, int caller)
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
     frame_acc acc;
     memset(&acc, 0, sizeof acc);
-    const double t0 = sh->job->timing ? now_ns() : 0.0;
+    const double t0 = sh->job->timing ? frame_now_ns() : 0.0;
     for (;;) {
         if (atomic_load_explicit(&sy->changed, memory_order_relaxed))
             break; /* another thread met the file changing: stop */
@@ -452,7 +358,7 @@ static void work(const frame_shared *common, int caller)
         if (caller && sh->phase == 0)
             test_hooks_tile(d);
     }
-    const double ns = sh->job->timing ? now_ns() - t0 : 0.0;
+    const double ns = sh->job->timing ? frame_now_ns() - t0 : 0.0;
     pthread_mutex_lock(&sy->lock);
     sy->sum.rays += acc.rays;
     sy->sum.hits += acc.hits;
@@ -462,8 +368,9 @@ static void work(const frame_shared *common, int caller)
     sy->sum.shadow_rays += acc.shadow_rays;
     sy->sum.ao_rays += acc.ao_rays;
     sy->sum.secondary_steps += acc.secondary_steps;
-    sy->sum.secondary_ns += acc.secondary_ns;
-    sy->thread_ns += ns;
+    sy->sum.shadow_ns += acc.shadow_ns;
+    sy->sum.ao_ns += acc.ao_ns;
+    sy->pass_ns[sh->phase] += ns - acc.shadow_ns - acc.ao_ns;
     pthread_mutex_unlock(&sy->lock);
 }
 
@@ -571,8 +478,14 @@ int frame_render(const frame_job *job, frame_stats *stats)
     int rc = 0;
     if (job->aa > 1) {
         sh.probes = calloc(npx, sizeof *sh.probes);
-        if (!sh.probes)
+        sh.tile_any = calloc((size_t)sh.tiles_x * sh.tiles_y, 1);
+        if (!sh.probes || !sh.tile_any) {
+            free(sh.probes);
+            free(sh.tile_any);
+            sh.probes = NULL;
+            sh.tile_any = NULL;
             rc = ENOMEM; /* one ray a pixel */
+        }
     }
     int rc1 = run_pass(&sh, 0);
     if (sh.probes && !atomic_load(&sy.changed)) {
@@ -581,6 +494,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
             rc1 = rc2;
     }
     free(sh.probes);
+    free(sh.tile_any);
     exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;
@@ -591,8 +505,13 @@ int frame_render(const frame_job *job, frame_stats *stats)
     stats->shadow_rays = sy.sum.shadow_rays;
     stats->ao_rays = sy.sum.ao_rays;
     stats->secondary_steps = sy.sum.secondary_steps;
-    stats->secondary_ns = sy.sum.secondary_ns;
-    stats->primary_ns = sy.thread_ns - sy.sum.secondary_ns;
+    stats->shadow_ns = sy.sum.shadow_ns;
+    stats->ao_ns = sy.sum.ao_ns;
+    stats->secondary_ns = sy.sum.shadow_ns + sy.sum.ao_ns;
+    stats->centre_ns = sy.pass_ns[0];
+    stats->sample_ns = sy.pass_ns[1];
+    stats->primary_ns = sy.pass_ns[0] + sy.pass_ns[1];
+    stats->samples = sy.sum.rays;
     stats->file_changed = atomic_load(&sy.changed);
     return rc ? rc : rc1;
 }

@@ -36,6 +36,8 @@ typedef struct frame_job {
     uint8_t *alpha;     /* width*height coverage bytes (255 * hit samples / samples,
                            rounded), or NULL; with it, rgb is the covered part's
                            colour (straight alpha) and misses are black */
+    int no_beam_edge;   /* 1: without the beam's edge trigger (aa.h), only the
+                           neighbour test chooses the pixels to sample (tests) */
     trace_traverse_fn traverse; /* NULL: the build's preferred implementation */
     int timing;         /* 1: time the secondary rays apart (frame_stats) */
     /* Called by the calling thread after each tile it finishes, with tiles
@@ -50,8 +52,13 @@ typedef struct frame_stats {
     uint64_t aa_pixels;         /* pixels traced again with samples (the edge test) */
     uint64_t aa_full;           /* of those, with all N x N (their corners disagreed) */
     uint64_t shadow_rays, ao_rays, secondary_steps;
+    uint64_t samples;           /* of the primary rays, the antialiasing samples */
     double primary_ns, secondary_ns; /* with job->timing: thread time summed over
                                         threads, spent on each kind of ray */
+    double centre_ns, sample_ns;     /* primary_ns in two: centre rays, samples (each
+                                        pass's time but its secondary rays') */
+    double shadow_ns, ao_ns;         /* secondary_ns in two (a hit's shared start
+                                        counts as its shadow ray's when it has one) */
     int file_changed; /* the mapped file changed under a thread (map_guard.h): image incomplete */
 } frame_stats;
 

@@ -27,6 +27,7 @@
 #include "render/outputs.h"
 #include "render/shade.h"
 #include "render/trace.h"
+#include "render/view_report.h"
 #include "render/views.h"
 
 _Static_assert(VIEWS_AA_MAX == AA_MAX && VIEWS_AO_MAX == AO_MAX_RAYS, "views limits");
@@ -388,31 +389,6 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     return EXIT_OK;
 }
 
-/* The per-view line: size, time, rate, hits; the supersampled share with
- * --aa; with -v the rays of each kind and their rates (thread time). */
-static void report_view(const render_args *o, const views_view *v, const frame_stats *st,
-                        double ms)
-{
-    const uint64_t px = (uint64_t)v->width * (uint64_t)v->height;
-    fprintf(stderr, "render: %s: %ldx%ld, %.1f ms, %.2f Mrays/s, %.1f%% hit", v->out, v->width,
-            v->height, ms, ms > 0 ? (double)st->rays / ms / 1e3 : 0.0,
-            100.0 * (double)st->hits / (double)px);
-    if (v->aa > 1)
-        fprintf(stderr, ", %.2f%% edge pixels, %.2f%% supersampled",
-                100.0 * (double)st->aa_pixels / (double)px, 100.0 * (double)st->aa_full / (double)px);
-    if (o->verbose) {
-        const double th = (double)o->threads;
-        fprintf(stderr, "; primary %.2f Mrays %.2f Mrays/s", (double)st->rays / 1e6,
-                st->primary_ns > 0 ? (double)st->rays * th / st->primary_ns * 1e3 : 0.0);
-        const double sec = (double)(st->shadow_rays + st->ao_rays);
-        if (sec > 0)
-            fprintf(stderr, ", shadow %.2f Mrays, ao %.2f Mrays, %.2f Mrays/s",
-                    (double)st->shadow_rays / 1e6, (double)st->ao_rays / 1e6,
-                    st->secondary_ns > 0 ? sec * th / st->secondary_ns * 1e3 : 0.0);
-    }
-    fputc('\n', stderr);
-}
-
 /* Renders one view and writes its images; adds its time and rays to the
  * totals. Returns EXIT_OK or EXIT_RUNTIME. */
 static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
@@ -473,7 +449,7 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     if (outputs_write_view(v, &img) != EXIT_OK)
         return EXIT_RUNTIME;
     if (!o->quiet)
-        report_view(o, v, &st, ms);
+        view_report(v, &st, ms, o->verbose, (unsigned)o->threads);
     return EXIT_OK;
 }
 

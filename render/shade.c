@@ -38,17 +38,23 @@ double shade_normal(const oct_tree *tree, const shade_params *p, const trace_hit
         n[0] = n[1] = n[2] = 0.0f;
         return 0.0;
     }
-    if (hit->exact) { /* the gradient, already facing the viewer */
-        for (int a = 0; a < 3; a++)
-            n[a] = (float)hit->normal[a];
-    } else {
-        uint32_t rec = tree->voxels[hit->voxel];
-        oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, n);
-        double facing = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
-        if (facing > 0.0) /* two-sided: face the viewer */
-            for (int a = 0; a < 3; a++)
-                n[a] = -n[a];
+    if (!hit->exact) {
+        float ns[3];
+        oct_normal_decode(tree->voxels[hit->voxel] & OCT_VOXEL_NORMAL_MASK, ns);
+        return shade_normal_stored(p, ns, dir, n);
     }
+    for (int a = 0; a < 3; a++) /* the gradient, already facing the viewer */
+        n[a] = (float)hit->normal[a];
+    double lam = n[0] * p->light[0] + n[1] * p->light[1] + n[2] * p->light[2];
+    return lam < 0.0 ? 0.0 : lam;
+}
+
+double shade_normal_stored(const shade_params *p, const float ns[3], const double dir[3],
+                           float n[3])
+{
+    double facing = ns[0] * dir[0] + ns[1] * dir[1] + ns[2] * dir[2];
+    for (int a = 0; a < 3; a++) /* two-sided: face the viewer */
+        n[a] = facing > 0.0 ? -ns[a] : ns[a];
     double lam = n[0] * p->light[0] + n[1] * p->light[1] + n[2] * p->light[2];
     return lam < 0.0 ? 0.0 : lam;
 }

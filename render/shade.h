@@ -30,6 +30,11 @@ int shade_set_light(shade_params *p, const double light[3]);
 double shade_normal(const oct_tree *tree, const shade_params *p, const trace_hit *hit,
                     const double dir[3], float n[3]);
 
+/* shade_normal for a voxel hit whose stored normal ns (oct_normal_decode
+ * of its record) the caller has already decoded: the same n and term. */
+double shade_normal_stored(const shade_params *p, const float ns[3], const double dir[3],
+                           float n[3]);
+
 /* The palette index of a hit's surface: the root's with --exact, else the
  * voxel's; 0 for a miss. */
 unsigned shade_surface(const oct_tree *tree, const trace_hit *hit);

@@ -10,23 +10,32 @@ double shadow_offset(const float n[3])
     return (double)fabsf(n[0]) + (double)fabsf(n[1]) + (double)fabsf(n[2]) + 0.25;
 }
 
-/* 1 when the voxel holding grid point g is known occupied. */
-static int voxel_occupied(const oct_tree *tree, const double g[3])
+/* The margin of the box around a start point: far above the rounding of
+ * its grid position when computed back from the world point. */
+#define START_MARGIN 0x1p-10
+
+/* 1 when the voxel holding grid point g is known occupied; s->anchor gets
+ * the deepest occupied cell holding the box g +- START_MARGIN. */
+static int voxel_occupied(const oct_tree *tree, const double g[3], shadow_start *s)
 {
-    const double m = 0x1p-10;
+    const double m = START_MARGIN;
     const double lo[3] = {g[0] - m, g[1] - m, g[2] - m}, hi[3] = {g[0] + m, g[1] + m, g[2] + m};
-    trace_anchor an;
-    trace_anchor_find(tree, lo, hi, &an);
-    if (an.depth + 1 != tree->levels)
+    trace_anchor *an = &s->anchor;
+    trace_anchor_find_near(tree, lo, hi, s->near ? an : NULL, an);
+    s->near = 1;
+    if (an->depth + 1 != tree->levels)
         return 0; /* an empty cell above the voxels, outside the cube, or a box on a face */
     const unsigned c = ((uint32_t)lo[0] & 1u) | ((uint32_t)lo[1] & 1u) << 1 |
                        ((uint32_t)lo[2] & 1u) << 2;
-    return (int)(an.node[an.depth].mask >> c & 1u);
+    return (int)(an->node[an->depth].mask >> c & 1u);
 }
 
 /* The start point from base (grid units, on the surface) along n, moved
- * on out of occupied voxels (shadow_origin). */
-static int origin_from(const oct_tree *tree, const double base[3], const float n[3], double o[3])
+ * on out of occupied voxels (shadow_origin). The anchor of the box around
+ * the start also holds s->eye.o, which is within rounding of g: it is the
+ * rays' anchor. */
+static int start_from(const oct_tree *tree, const double base[3], const float n[3],
+                      shadow_start *s)
 {
     const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double g[3];
@@ -34,34 +43,61 @@ static int origin_from(const oct_tree *tree, const double base[3], const float n
         const double h = shadow_offset(n) + (double)k;
         for (int a = 0; a < 3; a++)
             g[a] = base[a] + h * (double)n[a];
-        if (!voxel_occupied(tree, g)) {
+        if (!voxel_occupied(tree, g, s)) {
             for (int a = 0; a < 3; a++)
-                o[a] = tree->origin[a] + g[a] * vox;
+                s->o[a] = tree->origin[a] + g[a] * vox;
+            trace_eye_init(tree, s->o, &s->eye);
             return 1;
         }
     }
     return 0;
 }
 
-int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])
+int shadow_start_hit(const oct_tree *tree, const trace_hit *hit, const float n[3], shadow_start *s)
+{
+    float ns[3]; /* the stored normal: the plane's, n or -n */
+    oct_normal_decode(tree->voxels[hit->voxel] & OCT_VOXEL_NORMAL_MASK, ns);
+    return shadow_start_stored(tree, hit, ns, n, s);
+}
+
+int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                        const float n[3], shadow_start *s)
 {
     const uint32_t rec = tree->voxels[hit->voxel];
-    float ns[3]; /* the stored normal: the plane's, n or -n */
-    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, ns);
     const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
     double base[3];
     for (int a = 0; a < 3; a++)
         base[a] = (double)hit->xyz[a] + 0.5 + off * (double)ns[a];
-    return origin_from(tree, base, n, o);
+    return start_from(tree, base, n, s);
 }
 
-int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], double o[3])
+int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s)
 {
     const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double base[3];
     for (int a = 0; a < 3; a++)
         base[a] = (p[a] - tree->origin[a]) / vox;
-    return origin_from(tree, base, n, o);
+    return start_from(tree, base, n, s);
+}
+
+int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])
+{
+    shadow_start s;
+    s.near = 0;
+    const int ok = shadow_start_hit(tree, hit, n, &s);
+    for (int a = 0; ok && a < 3; a++)
+        o[a] = s.o[a];
+    return ok;
+}
+
+int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], double o[3])
+{
+    shadow_start s;
+    s.near = 0;
+    const int ok = shadow_start_at(tree, p, n, &s);
+    for (int a = 0; ok && a < 3; a++)
+        o[a] = s.o[a];
+    return ok;
 }
 
 int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
@@ -76,6 +112,22 @@ int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_
     if (!traverse)
         traverse = trace_impls[0].traverse;
     traverse(tree, opts, &r, NULL, &h);
+    *steps += h.steps;
+    return h.hit;
+}
+
+int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                        const shadow_start *s, const double d[3], double t_max, uint64_t *steps)
+{
+    trace_ray r;
+    if (!trace_setup_eye(&s->eye, d, &r))
+        return 0; /* as trace_setup: the ray misses the cube */
+    if (t_max < INFINITY && !trace_clip(&r, 0.0, t_max))
+        return 0;
+    trace_hit h;
+    if (!traverse)
+        traverse = trace_impls[0].traverse;
+    traverse(tree, opts, &r, &s->anchor, &h);
     *steps += h.steps;
     return h.hit;
 }

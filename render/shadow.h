@@ -49,10 +49,37 @@ int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], 
  * whose place is known without the voxel's stored plane). */
 int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], double o[3]);
 
+/* What the secondary rays of one hit share: their start point o
+ * (shadow_origin's), its grid position, and its anchor, the deepest
+ * occupied cell around it (found by the test that the start is not inside a
+ * voxel, so it costs no walk of its own), where every one of those rays'
+ * descents from the root arrives. */
+typedef struct shadow_start {
+    double o[3];
+    trace_eye eye;       /* eye.ok = 0: no ray from o can be set up */
+    trace_anchor anchor;
+    int near;            /* in and out: 1 when anchor holds an earlier start's
+                            anchor (same tree), which speeds the next search
+                            up (trace_anchor_find_near); 0 the first time */
+} shadow_start;
+
+/* shadow_origin and shadow_origin_at, with the shared part in *s (set
+ * s->near first). */
+int shadow_start_hit(const oct_tree *tree, const trace_hit *hit, const float n[3], shadow_start *s);
+/* shadow_start_hit with the hit voxel's stored normal ns already decoded. */
+int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                        const float n[3], shadow_start *s);
+int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s);
+
 /* 1 when the ray o + t d (d unit), 0 <= t <= t_max (+inf allowed), meets an
  * occupied voxel (by opts' rule), traced by `traverse` (NULL: the build's
  * preferred implementation); 0 otherwise. Adds its DDA steps to *steps. */
 int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                    const double o[3], const double d[3], double t_max, uint64_t *steps);
+
+/* shadow_blocked from s->o, started at s's anchor: the same answer and
+ * steps. */
+int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                        const shadow_start *s, const double d[3], double t_max, uint64_t *steps);
 
 #endif

@@ -92,6 +92,7 @@ typedef struct trace_eye {
     double n, scale;  /* N = 2^L, N / edge */
     uint32_t nvox;
     int inside[3];    /* 0 <= o_a <= N */
+    int all_inside;   /* all three */
     int ok;
 } trace_eye;
 
@@ -160,6 +161,12 @@ typedef struct trace_anchor {
  * inside the root cube gets the root. */
 void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
                        trace_anchor *a);
+
+/* The same anchor, found faster for a box near the one `near` was found
+ * for (an anchor of this tree, or NULL): the nodes the two share are
+ * copied from it. a may be near. */
+void trace_anchor_find_near(const oct_tree *tree, const double lo[3], const double hi[3],
+                            const trace_anchor *near, trace_anchor *a);
 
 /* trace_ray_prepared for a ray whose start point (at r->t_start) lies in
  * the box a was found for: the descent begins at the anchor. Hit, voxel, t

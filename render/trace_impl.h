@@ -49,6 +49,10 @@ typedef struct trace_impl {
 extern const trace_impl trace_impls[];
 extern const unsigned trace_impl_count;
 
+/* trace_setup_eye without its shortcut for an eye inside the root cube:
+ * the tests compare the two. */
+int trace_setup_eye_general(const trace_eye *e, const double dir[3], trace_ray *r);
+
 /* --refine in one occupied voxel (render/trace_refine.c). */
 int trace_refine_voxel(const oct_tree *tree, const trace_ray *r, uint64_t idx, const uint32_t v[3],
                        double t_in, double t_out, int *side, double *t_hit);

@@ -50,11 +50,63 @@ int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e)
         e->hi[a] = e->n - e->o[a];
         e->inside[a] = !(e->o[a] < 0.0 || e->o[a] > e->n);
     }
+    e->all_inside = e->inside[0] && e->inside[1] && e->inside[2];
     e->ok = 1;
     return 1;
 }
 
+/* trace_setup_eye from an eye inside the root cube (the start of secondary
+ * rays): there every axis' slab entry time is <= 0, so the ray is never
+ * re-based, and its slab exit time is the root exit time T(n or 0) the
+ * general path computes afterwards, the same product of the same values.
+ * So: the same ray, bit for bit, in one pass over the axes. */
+static int setup_inside(const trace_eye *e, const double dir[3], trace_ray *r)
+{
+    const double scale = e->scale;
+    double d[3];
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++)
+        d[a] = dir[a] * scale;
+    if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
+        return 0;
+    unsigned active = 0;
+    double t_end = INFINITY;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const double inv = 1.0 / d[a];
+        const int act = fabs(inv) <= DBL_MAX;
+        active |= (unsigned)act << a;
+        r->inv[a] = act ? inv : 1.0;
+        r->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
+        r->d[a] = act ? d[a] : 0.0;
+        r->o[a] = e->o[a];
+        r->ot[a] = act ? e->o[a] : -INFINITY;
+        r->v[a] = act ? 0u : floor_clamp(e->o[a], 0, e->nvox - 1);
+        if (act) {
+            const double te = (d[a] < 0.0 ? e->lo[a] : e->hi[a]) * inv;
+            if (te < t_end)
+                t_end = te;
+        }
+    }
+    if (!active || !(t_end > 0.0))
+        return 0;
+    r->active = active;
+    r->t_base = 0.0;
+    r->t_start = 0.0;
+    r->t_end = t_end;
+    return 1;
+}
+
 int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
+{
+    if (!e->ok)
+        return 0;
+    if (e->all_inside)
+        return setup_inside(e, dir, r);
+    return trace_setup_eye_general(e, dir, r);
+}
+
+int trace_setup_eye_general(const trace_eye *e, const double dir[3], trace_ray *r)
 {
     if (!e->ok)
         return 0;
@@ -164,10 +216,18 @@ int trace_clip(trace_ray *r, double t_lo, double t_hi)
     return r->t_start < r->t_end;
 }
 
-void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
-                       trace_anchor *a)
+/* trace_anchor_find, the nodes down to the deepest cell the box shares
+ * with `near`'s (a result of this search on the same tree, or NULL) taken
+ * from near instead of the tree: the same nodes, as the search from the
+ * root passes them. a may be near. */
+static void anchor_search(const oct_tree *tree, const double lo[3], const double hi[3],
+                          const trace_anchor *near, trace_anchor *a)
 {
     const unsigned levels = tree->levels;
+    const unsigned pd = near ? near->depth : 0;
+    uint32_t pc[3] = {0, 0, 0};
+    for (int i = 0; pd && i < 3; i++)
+        pc[i] = near->cell[i];
     a->depth = 0;
     a->cell[0] = a->cell[1] = a->cell[2] = 0;
     if (tree->node_count[0] == 0 || levels < 1 || levels > OCT_MAX_LEVELS)
@@ -179,28 +239,60 @@ void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi
     for (int i = 0; i < 3; i++)
         if (!(lo[i] > 0.0 && hi[i] < n && lo[i] <= hi[i])) /* NaN too */
             return;
-    /* whole voxels: the box lies in voxels [vl, vh] */
-    uint32_t vl[3], vh[3];
+    /* whole voxels: the box lies in voxels [vl, vh]; it straddles two
+     * cells of depth d exactly when vl ^ vh has a bit at levels - d or
+     * above, so the deepest depth it can reach is known at once */
+    uint32_t vl[3], diff = 0, off = 0;
     for (int i = 0; i < 3; i++) {
         vl[i] = (uint32_t)lo[i];
-        vh[i] = (uint32_t)hi[i];
+        diff |= vl[i] ^ (uint32_t)hi[i];
+        off |= vl[i] ^ pc[i];
     }
-    for (unsigned d = 1; d < levels; d++) {
+    unsigned dmax = levels - 1;
+    if (diff) {
+        const unsigned bits = 32u - (unsigned)__builtin_clz(diff);
+        if (bits > levels - 1u)
+            return; /* it straddles two children of the root */
+        dmax = levels - bits < dmax ? levels - bits : dmax;
+    }
+    /* near's cell of depth d <= pd holds the box's when vl and its corner
+     * agree above bit levels - d */
+    unsigned d0 = pd < dmax ? pd : dmax;
+    if (off) {
+        const unsigned bits = 32u - (unsigned)__builtin_clz(off);
+        const unsigned common = bits >= levels ? 0 : levels - bits;
+        d0 = common < d0 ? common : d0;
+    }
+    if (a != near)
+        for (unsigned d = 1; d <= d0; d++)
+            a->node[d] = near->node[d];
+    unsigned d = d0 + 1;
+    for (; d <= dmax; d++) {
         const unsigned sh = levels - d;
-        if ((vl[0] >> sh) != (vh[0] >> sh) || (vl[1] >> sh) != (vh[1] >> sh) ||
-            (vl[2] >> sh) != (vh[2] >> sh))
-            return; /* the box straddles two cells of depth d */
         const unsigned c = (vl[0] >> sh & 1u) | (vl[1] >> sh & 1u) << 1 | (vl[2] >> sh & 1u) << 2;
         const uint32_t m = a->node[d - 1].mask;
         if (!(m >> c & 1u))
-            return; /* an empty cell: its parent is the deepest occupied one */
+            break; /* an empty cell: its parent is the deepest occupied one */
         const uint64_t idx = a->node[d - 1].prefix + oct_popcount64(m & ((1u << c) - 1u));
         const oct_children ch = oct_node_children(tree->groups[d], idx);
         a->node[d].mask = ch.mask;
         a->node[d].prefix = ch.first;
         a->node[d].ci = c;
-        a->depth = d;
-        for (int i = 0; i < 3; i++)
-            a->cell[i] = vl[i] >> sh << sh;
     }
+    a->depth = d - 1;
+    const unsigned sh = levels - a->depth;
+    for (int i = 0; a->depth && i < 3; i++)
+        a->cell[i] = vl[i] >> sh << sh;
+}
+
+void trace_anchor_find(const oct_tree *tree, const double lo[3], const double hi[3],
+                       trace_anchor *a)
+{
+    anchor_search(tree, lo, hi, NULL, a);
+}
+
+void trace_anchor_find_near(const oct_tree *tree, const double lo[3], const double hi[3],
+                            const trace_anchor *near, trace_anchor *a)
+{
+    anchor_search(tree, lo, hi, near, a);
 }

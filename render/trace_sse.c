@@ -244,7 +244,11 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
         /* the start lies in the anchor's cell: the descent from the root
          * would take its path */
         d = anchor->depth;
-        memcpy(fr, anchor->node, (d + 1) * sizeof fr[0]);
+        /* a frame a register move (the layouts are one: trace_impl.h);
+           shorter than a call to memcpy for the few frames of an anchor */
+        for (unsigned k = 0; k <= d; k++)
+            _mm_storeu_si128((__m128i *)(void *)&fr[k],
+                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k]));
         size = UINT32_C(1) << (levels - d);
         V = _mm_setr_epi32((int32_t)anchor->cell[0], (int32_t)anchor->cell[1],
                            (int32_t)anchor->cell[2], 0);

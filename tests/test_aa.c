@@ -2,7 +2,9 @@
  * of a sphere's silhouette against the exact area of the disc over each
  * pixel square (numeric integration); the edge test's rule; colour
  * averaged in linear light; depth kept from the centre ray; the image the
- * same whatever the thread count and traversal implementation. */
+ * same whatever the thread count and traversal implementation; the beam's
+ * edge trigger finds what lies between centre rays; samples started at
+ * their sub-block's start are those traced whole. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -165,7 +167,7 @@ static void test_deterministic_and_centre_depth(void **state)
 static void test_edge_rule(void **state)
 {
     (void)state;
-    aa_probe a = {100.0f, INFINITY, {0, 0, 1}, 0, 1}, b = a;
+    aa_probe a = {100.0f, INFINITY, {0, 0, 1}, 0, 1, 0}, b = a;
     assert_false(aa_differs(&a, &b));
     b.hit = 0;
     assert_true(aa_differs(&a, &b));
@@ -184,6 +186,17 @@ static void test_edge_rule(void **state)
     b.n[0] = 0.3f; /* 17 degrees */
     b.n[2] = 0.954f;
     assert_false(aa_differs(&a, &b));
+    /* a pixel of a sub-block the beam marked needs samples, its
+       neighbours all alike */
+    aa_probe grid[9];
+    for (int k = 0; k < 9; k++) {
+        grid[k] = a;
+        grid[k].hit = 0;
+    }
+    assert_false(aa_needs(grid, 3, 3, 1, 1));
+    grid[4].beam_edge = 1;
+    assert_true(aa_needs(grid, 3, 3, 1, 1));
+    assert_false(aa_needs(grid, 3, 3, 0, 0));
     aa_probe m1 = a, m2 = a; /* two misses never differ */
     m1.hit = m2.hit = 0;
     m1.t = 1.0f;
@@ -248,6 +261,102 @@ static void test_linear_average(void **state)
     tree_util_free(t);
 }
 
+/* The beam's edge trigger: one voxel, a third of a pixel wide, at the
+ * corner of four pixels, between their centre rays. Every centre ray
+ * misses it, so the neighbour test alone samples nothing; the four beam
+ * sub-blocks whose pyramids it meets are marked, and the samples of the
+ * four pixels round the corner find it. */
+static void test_beam_edge_trigger(void **state)
+{
+    (void)state;
+    const uint32_t vox[1][3] = {{128, 128, 100}};
+    oct_tree *t = tree_util_simple(8, vox, 1);
+    assert_non_null(t);
+    /* from 0.35 above its top face, a pixel is 3 voxels wide there */
+    const double c = 128.5 / 256.0, top = 101.0 / 256.0;
+    const double eye[3] = {c, c, top + 0.35}, target[3] = {c, c, 0.0}, up[3] = {0, 1, 0};
+    camera cam;
+    assert_int_equal(camera_init(&cam, eye, target, up, 30.0, 16, 16), CAMERA_OK);
+    uint8_t rgb[16 * 16 * 3], alpha[16 * 16];
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = t;
+    job.cam = &cam;
+    job.opts.split = 8;
+    job.shade.ambient = 0.2f;
+    shade_default_light(&cam, job.shade.light);
+    job.rgb = rgb;
+    job.alpha = alpha;
+    job.threads = 1;
+    job.beam_size = FRAME_BEAM_DEFAULT;
+    job.aa = 4;
+    frame_stats st;
+    for (int trigger = 0; trigger <= 1; trigger++) {
+        job.no_beam_edge = !trigger;
+        assert_int_equal(frame_render(&job, &st), 0);
+        assert_int_equal(st.hits, 0); /* no centre ray meets the voxel */
+        unsigned covered = 0;
+        for (uint32_t j = 0; j < 16; j++)
+            for (uint32_t i = 0; i < 16; i++) {
+                const int corner = (i == 7 || i == 8) && (j == 7 || j == 8);
+                if (trigger && corner)
+                    assert_true(alpha[j * 16 + i] > 0);
+                else
+                    assert_int_equal(alpha[j * 16 + i], 0);
+                covered += alpha[j * 16 + i] > 0;
+            }
+        /* the four middle sub-blocks of 4 x 4 pixels */
+        assert_int_equal(st.aa_pixels, trigger ? 64 : 0);
+        assert_int_equal(covered, trigger ? 4 : 0);
+    }
+    tree_util_free(t);
+}
+
+/* The samples start at their pixel's sub-block start, from an anchor:
+ * without the edge trigger (which --beam 0 has not), the image is that of
+ * samples traced whole (--beam 0), for several beam block sizes. */
+static void test_sample_starts_exact(void **state)
+{
+    (void)state;
+    scene s = sphere_scene(7, 40.0, 160.0, 40.0);
+    const size_t np = W * H;
+    uint8_t *rgb = malloc(np * 3), *ref = malloc(np * 3), *alpha = malloc(np), *aref = malloc(np);
+    assert_true(rgb && ref && alpha && aref);
+    frame_job job;
+    memset(&job, 0, sizeof job);
+    job.tree = s.tree;
+    job.cam = &s.cam;
+    job.opts.split = s.tree->levels;
+    job.shade.ambient = 0.2f;
+    shade_default_light(&s.cam, job.shade.light);
+    job.threads = 2;
+    job.aa = 3;
+    job.no_beam_edge = 1;
+    frame_stats st, st0;
+    for (int refine = 0; refine <= 1; refine++) {
+        job.opts.refine = refine;
+        job.rgb = ref;
+        job.alpha = aref;
+        job.beam_size = 0;
+        assert_int_equal(frame_render(&job, &st0), 0);
+        job.rgb = rgb;
+        job.alpha = alpha;
+        static const unsigned sizes[] = {5, 16, FRAME_BEAM_DEFAULT};
+        for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+            job.beam_size = sizes[k];
+            assert_int_equal(frame_render(&job, &st), 0);
+            assert_memory_equal(rgb, ref, np * 3);
+            assert_memory_equal(alpha, aref, np);
+            assert_true(st.aa_pixels == st0.aa_pixels && st.rays == st0.rays);
+        }
+    }
+    free(rgb);
+    free(ref);
+    free(alpha);
+    free(aref);
+    tree_util_free(s.tree);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -255,6 +364,8 @@ int main(void)
         cmocka_unit_test(test_deterministic_and_centre_depth),
         cmocka_unit_test(test_edge_rule),
         cmocka_unit_test(test_linear_average),
+        cmocka_unit_test(test_beam_edge_trigger),
+        cmocka_unit_test(test_sample_starts_exact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

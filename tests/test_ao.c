@@ -33,6 +33,10 @@ static void test_directions(void **state)
                 ao_direction(ns[k], r, m, ao_seed(3, 7), d);
                 ao_direction(ns[k], r, m, ao_seed(3, 7), e);
                 assert_memory_equal(d, e, sizeof d);
+                ao_frame f; /* the frame once, the rays in it: the same bits */
+                ao_basis(ns[k], &f);
+                ao_direction_in(&f, r, m, ao_seed(3, 7), e);
+                assert_memory_equal(d, e, sizeof d);
                 const double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
                 assert_true(fabs(len - 1.0) < 1e-12);
                 const double c = d[0] * ns[k][0] + d[1] * ns[k][1] + d[2] * ns[k][2];
@@ -163,6 +167,77 @@ static void test_frame_ao_deterministic(void **state)
     tree_util_free(t);
 }
 
+/* The secondary rays of a hit share its start (shadow_start_hit): its
+ * grid position and its anchor. Each answer and step count is that of the
+ * ray traced alone from the world start point (shadow_blocked, ao_factor),
+ * on every implementation, with and without --refine, for hits of all
+ * kinds: floor, wall, the corner between them, a ball. */
+static void test_shared_start_same_answers(void **state)
+{
+    (void)state;
+    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
+                   shape_sphere(40, 40, 30, 8)};
+    sh[0].lo[0] = 20;
+    sh[1].lo[2] = 20;
+    oct_tree *t = shapes_build(LEVELS, NV, sh, 3, 1);
+    assert_non_null(t);
+    const double eye[3] = {150, 110, 120};
+    static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5}};
+    unsigned long checked = 0, deep = 0, blocked = 0, shaded = 0;
+    shadow_start st; /* kept from hit to hit: each start's search starts near the last */
+    st.near = 0;
+    for (unsigned impl = 0; impl < trace_impl_count; impl++)
+        for (int refine = 0; refine <= 1; refine++) {
+            const trace_opts o = {.split = LEVELS, .refine = refine};
+            trace_traverse_fn fn = trace_impls[impl].traverse;
+            for (int y = 0; y < 40; y++)
+                for (int x = 0; x < 40; x++) {
+                    const double target[3] = {18.0 + 1.13 * x, 18.0 + 1.07 * y, 21.3};
+                    double dir[3];
+                    for (int a = 0; a < 3; a++)
+                        dir[a] = target[a] - eye[a];
+                    trace_hit h;
+                    if (!trace_ray_cast(t, &o, eye, dir, &h))
+                        continue;
+                    float n[3];
+                    oct_normal_decode(t->voxels[h.voxel] & OCT_VOXEL_NORMAL_MASK, n);
+                    if (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0.0)
+                        for (int a = 0; a < 3; a++)
+                            n[a] = -n[a];
+                    double org[3];
+                    const int ok = shadow_origin(t, &h, n, org);
+                    assert_int_equal(shadow_start_hit(t, &h, n, &st), ok);
+                    if (!ok)
+                        continue;
+                    assert_memory_equal(st.o, org, sizeof org);
+                    deep += st.anchor.depth + 2 >= LEVELS;
+                    const uint32_t seed = ao_seed((uint32_t)x, (uint32_t)y);
+                    uint64_t s0 = 0, s1 = 0;
+                    const float f0 = ao_factor(t, &o, fn, org, n, 0, 16, 16, seed, &s0);
+                    const float f1 = ao_factor_from(t, &o, fn, &st, n, 0, 16, 16, seed, &s1);
+                    assert_true(f0 == f1);
+                    assert_true(s0 == s1);
+                    shaded += f0 < 1.0f;
+                    for (size_t l = 0; l < sizeof lights / sizeof lights[0]; l++) {
+                        s0 = s1 = 0;
+                        const int b0 = shadow_blocked(t, &o, fn, org, lights[l], INFINITY, &s0);
+                        const int b1 =
+                            shadow_blocked_from(t, &o, fn, &st, lights[l], INFINITY, &s1);
+                        assert_int_equal(b0, b1);
+                        assert_true(s0 == s1);
+                        blocked += (unsigned)b0;
+                    }
+                    checked++;
+                }
+        }
+    print_message("shared starts: %lu hits, %lu anchored within 2 levels of the voxels, "
+                  "%lu shadow rays blocked, %lu partly occluded\n",
+                  checked, deep, blocked, shaded);
+    assert_true(checked > 1000);
+    assert_true(deep > checked / 2 && blocked > 50 && shaded > 100);
+    tree_util_free(t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -170,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_plane_alone_is_open),
         cmocka_unit_test(test_concave_corner_is_darker),
         cmocka_unit_test(test_frame_ao_deterministic),
+        cmocka_unit_test(test_shared_start_same_answers),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
