@@ -235,6 +235,7 @@ int exact_worker_init(exact_worker *w, const exact_scene *es)
     w->scene = es;
     w->fast = w->slow = 0;
     w->key_slot = UINT32_MAX;
+    w->key_t = 0.0;
     w->have = 0;
     return exact_scratch_init(&w->scratch, es->max_n);
 }
@@ -264,13 +265,17 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         l.d[a] = r->d[a] * es->h;
         dd += r->d[a] * r->d[a];
     }
-    if (slot != w->key_slot || memcmp(w->key, l.o, sizeof l.o) ||
+    /* a new line, cell, or traversal (a line traced again starts before
+     * where it was last tested): the models start afresh, so that what a ray
+     * finds depends on that ray alone */
+    if (slot != w->key_slot || t_in < w->key_t || memcmp(w->key, l.o, sizeof l.o) ||
         memcmp(w->key + 3, l.d, sizeof l.d)) {
         memcpy(w->key, l.o, sizeof l.o);
         memcpy(w->key + 3, l.d, sizeof l.d);
         w->key_slot = slot;
         w->have = 0;
     }
+    w->key_t = t_in;
     const double widen = 0x1p-16 / sqrt(dd); /* 2^-16 voxel along the ray */
     double a = t_in - widen, b = t_out + widen;
     if (a < -r->t_base)

@@ -56,10 +56,11 @@ typedef struct exact_worker {
     const exact_scene *scene;
     exact_scratch scratch;
     uint64_t fast, slow; /* statistics: candidate tests the fast path decided, and not */
-    /* The fast path's models (exact_fast.h) for the line of the last test,
-     * valid while its voxels stay in one coarse cell: candidate k of the
-     * cell has one when bit k of `have` is set. */
-    double key[6];
+    /* The fast path's models (exact_fast.h) for the line of the last test
+     * (key: o, d; key_t: its t_in), valid while its voxels stay in one
+     * coarse cell: candidate k of the cell has one when bit k of `have` is
+     * set. */
+    double key[6], key_t;
     uint32_t key_slot, have;
     exact_model model[EXACT_MODELS];
 } exact_worker;
