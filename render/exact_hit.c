@@ -16,7 +16,9 @@ int exact_scratch_init(exact_scratch *w, uint32_t n)
     w->islots = malloc(n * sizeof *w->islots);
     w->gslots = malloc(n * sizeof *w->gslots);
     w->dslots = malloc(n * sizeof *w->dslots);
-    if (!w->slots || !w->islots || !w->gslots || !w->dslots) {
+    w->idir = malloc(n * sizeof *w->idir);
+    w->dir = malloc(n * sizeof *w->dir);
+    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir) {
         exact_scratch_free(w);
         return -1;
     }
@@ -29,6 +31,10 @@ void exact_scratch_free(exact_scratch *w)
     free(w->islots);
     free(w->gslots);
     free(w->dslots);
+    free(w->idir);
+    free(w->dir);
+    w->idir = NULL;
+    w->dir = NULL;
     w->slots = NULL;
     w->islots = NULL;
     w->gslots = NULL;
@@ -36,9 +42,7 @@ void exact_scratch_free(exact_scratch *w)
     w->n = 0;
 }
 
-/* The box spanned by the line's points for t in [a, b]: each end is two
- * roundings (product, sum) from the real point, so two steps outward. */
-static void segment_box(const exact_line *l, double a, double b, interval box[3])
+void exact_segment_box(const exact_line *l, double a, double b, interval box[3])
 {
     for (int k = 0; k < 3; k++) {
         const double pa = l->o[k] + a * l->d[k], pb = l->o[k] + b * l->d[k];
@@ -54,15 +58,9 @@ static double g_at(const tape *t, exact_scratch *w, const exact_line *l, double 
                      w->slots);
 }
 
-/* The root in [a, b] where ga and gb differ in sign (or one is 0):
- * Illinois regula falsi, every fourth step a bisection so the bracket
- * always shrinks, until no double lies strictly between its ends. A NaN
- * inside (only on a flagged segment) moves the far end in, as refcast does.
- * A sign change through a pole is no root: there |g| grows as the bracket
- * closes, and a bracket whose ends both end above the larger of its first
- * ends' finite |g| gives +inf. */
-static double refine(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                     double ga, double gb)
+/* (see exact_hit.h) */
+double exact_refine(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                    double ga, double gb)
 {
     if (ga == 0.0)
         return a;
@@ -132,7 +130,7 @@ double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const
     while (top > 0) {
         const seg s = stack[--top];
         interval box[3];
-        segment_box(l, s.a, s.b, box);
+        exact_segment_box(l, s.a, s.b, box);
         unsigned flags = 0;
         const interval F = tape_eval_interval(cull, box, w->islots, &flags);
         /* F encloses f wherever f is defined (flagged or not), and the NaN
@@ -153,7 +151,7 @@ double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const
                 if (crosses(ga, gb)) {
                     if (kind)
                         *kind = EXACT_ROOT;
-                    return refine(t, w, l, s.a, s.b, ga, gb); /* (no pole: monotone) */
+                    return exact_refine(t, w, l, s.a, s.b, ga, gb); /* (no pole: monotone) */
                 }
                 continue;
             }
@@ -163,7 +161,7 @@ double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const
             if (ga != ga && gb != gb)
                 continue; /* undefined here: not a surface point */
             if (ga == ga && gb == gb && crosses(ga, gb)) {
-                const double r = refine(t, w, l, s.a, s.b, ga, gb);
+                const double r = exact_refine(t, w, l, s.a, s.b, ga, gb);
                 if (r < INFINITY) {
                     if (kind)
                         *kind = EXACT_ROOT;

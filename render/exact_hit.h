@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "common/expr/tape.h"
+#include "common/expr/tape_dir.h"
 
 /* A line p(t) = o + t * d in the tape's (world) coordinates. */
 typedef struct exact_line {
@@ -21,12 +22,29 @@ typedef struct exact_scratch {
     interval *islots;
     tape_idual *gslots;
     tape_dual *dslots;
+    tape_idir1 *idir; /* the fast path's (render/exact_fast.c) */
+    tape_dir1 *dir;
 } exact_scratch;
 
 /* Allocates scratch for tapes of up to n instructions: 0, or -1 when out
  * of memory (then nothing is held). */
 int exact_scratch_init(exact_scratch *w, uint32_t n);
 void exact_scratch_free(exact_scratch *w); /* accepts a zeroed or freed one */
+
+/* The box spanned by the line's points for t in [a, b] (a <= b): each end
+ * is two roundings (product, sum) from the real point, so two steps out. */
+void exact_segment_box(const exact_line *l, double a, double b, interval box[3]);
+
+/* The root in [a, b] (a < b) where g's double evaluations ga = g(a) and
+ * gb = g(b) differ in sign (or one is 0): Illinois regula falsi, every
+ * fourth step a bisection so the bracket always shrinks, until no double
+ * lies strictly between its ends; then the end where |g| is smaller (a on
+ * a tie). A NaN inside (only on a flagged segment) moves the far end in, as
+ * refcast does. A sign change through a pole is no root: there |g| grows as
+ * the bracket closes, and a bracket whose ends both end above the larger of
+ * its first ends' finite |g| gives +inf. */
+double exact_refine(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                    double ga, double gb);
 
 /* Segments no wider than this share of max(1, |t|) are the resolution
  * limit: the finder decides there (see exact_first_root). */

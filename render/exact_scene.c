@@ -6,6 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/expr/tape_hess.h"
+#include "render/exact_fast.h"
+
 /* Growable pools while building; pointers are set once they stop moving. */
 typedef struct builder {
     exact_scene *es;
@@ -17,6 +20,7 @@ typedef struct builder {
         uint64_t exact[2], cull[2]; /* insn, konst pool offsets; UINT64_MAX: the whole tape */
     } *off;                         /* per candidate */
     interval *slots;
+    tape_ihess *hslots;
     tape_insn *tmp_insn;
     tape_const *tmp_konst;
     uint32_t *tmp_scratch;
@@ -121,8 +125,11 @@ static int add_cell(builder *b, const uint32_t c[3])
         const double per_voxel = ldexp(F.hi - F.lo, -(int)(L - D));
         es->whole_insns += t->n;
         if (store_pruned(b, t, flags, ldexp(per_voxel, -30), &k->t, b->off[es->ncand].exact,
-                         &es->pruned_insns) ||
-            store_pruned(b, t, flags, 1e-3 * per_voxel, &k->cull, b->off[es->ncand].cull,
+                         &es->pruned_insns))
+            return -1;
+        /* (k->t's arrays are still those tape_prune_const wrote, or t's) */
+        tape_hess_mag(&k->t, box, b->hslots, k->hmag);
+        if (store_pruned(b, t, flags, 1e-3 * per_voxel, &k->cull, b->off[es->ncand].cull,
                          &es->cull_insns))
             return -1;
         es->ncand++;
@@ -178,11 +185,12 @@ int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, u
     const size_t cells = (size_t)1 << (3 * es->depth);
     es->cell_slot = malloc(cells * sizeof *es->cell_slot);
     b.slots = malloc(nmax * sizeof *b.slots);
+    b.hslots = malloc(nmax * sizeof *b.hslots);
     b.tmp_insn = malloc(nmax * sizeof *b.tmp_insn);
     b.tmp_konst = malloc(((size_t)cmax + nmax) * sizeof *b.tmp_konst);
     b.tmp_scratch = malloc(nmax * sizeof *b.tmp_scratch);
     int rc = -1;
-    if (es->cell_slot && b.slots && b.tmp_insn && b.tmp_konst && b.tmp_scratch) {
+    if (es->cell_slot && b.slots && b.hslots && b.tmp_insn && b.tmp_konst && b.tmp_scratch) {
         memset(es->cell_slot, 0xff, cells * sizeof *es->cell_slot);
         const uint32_t root[3] = {0, 0, 0};
         rc = tree->node_count[0] ? visit(&b, 0, 0, root) : 0;
@@ -203,6 +211,7 @@ int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, u
     }
     free(b.off);
     free(b.slots);
+    free(b.hslots);
     free(b.tmp_insn);
     free(b.tmp_konst);
     free(b.tmp_scratch);
@@ -224,6 +233,10 @@ void exact_scene_free(exact_scene *es)
 int exact_worker_init(exact_worker *w, const exact_scene *es)
 {
     w->scene = es;
+    w->fast = w->slow = 0;
+    w->key_slot = UINT32_MAX;
+    w->key_t = 0.0;
+    w->have = 0;
     return exact_scratch_init(&w->scratch, es->max_n);
 }
 
@@ -252,6 +265,17 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         l.d[a] = r->d[a] * es->h;
         dd += r->d[a] * r->d[a];
     }
+    /* a new line, cell, or traversal (a line traced again starts before
+     * where it was last tested): the models start afresh, so that what a ray
+     * finds depends on that ray alone */
+    if (slot != w->key_slot || t_in < w->key_t || memcmp(w->key, l.o, sizeof l.o) ||
+        memcmp(w->key + 3, l.d, sizeof l.d)) {
+        memcpy(w->key, l.o, sizeof l.o);
+        memcpy(w->key + 3, l.d, sizeof l.d);
+        w->key_slot = slot;
+        w->have = 0;
+    }
+    w->key_t = t_in;
     const double widen = 0x1p-16 / sqrt(dd); /* 2^-16 voxel along the ray */
     double a = t_in - widen, b = t_out + widen;
     if (a < -r->t_base)
@@ -262,7 +286,21 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         if (!(a <= b))
             break;
         const exact_cand *c = &es->cand[k];
-        const double t = exact_first_root(&c->t, &c->cull, &w->scratch, &l, a, b, NULL);
+        const double curv = exact_fast_curv(c->hmag, l.d);
+        double t = INFINITY;
+        int st = EXACT_FAST_UNDECIDED;
+        const uint32_t j = k - es->first[slot];
+        if (curv < INFINITY && j < EXACT_MODELS) {
+            int have = w->have >> j & 1u;
+            st = exact_fast_root(&c->t, &w->scratch, &l, a, b, curv, &w->model[j], &have, &t);
+            w->have = (w->have & ~(UINT32_C(1) << j)) | (uint32_t)have << j;
+        }
+        if (st == EXACT_FAST_UNDECIDED) {
+            w->slow++;
+            t = exact_first_root(&c->t, &c->cull, &w->scratch, &l, a, b, NULL);
+        } else {
+            w->fast++;
+        }
         if (t < best) {
             best = t;
             best_k = k;

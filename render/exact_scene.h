@@ -10,6 +10,7 @@
 
 #include "common/expr/tape.h"
 #include "format/oct.h"
+#include "render/exact_fast.h"
 #include "render/exact_hit.h"
 #include "render/trace.h"
 
@@ -23,6 +24,8 @@ typedef struct exact_cand {
     tape t;           /* pruned for the cell, as exact as the whole tape (points,
                          derivative); arrays in the scene's pools */
     tape cull;        /* pruned coarsely, for the interval that drops segments */
+    double hmag[6];   /* magnitudes of t's Hessian enclosure over the cell
+                         (tape_hess_mag): +inf where the fast path is off */
 } exact_cand;
 
 typedef struct exact_scene {
@@ -46,10 +49,20 @@ typedef struct exact_scene {
 int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, unsigned depth);
 void exact_scene_free(exact_scene *es); /* accepts a zeroed or freed one */
 
+#define EXACT_MODELS 8 /* candidates of a cell that keep a model */
+
 /* A thread's state for the exact test: the scene and scratch for its tapes. */
 typedef struct exact_worker {
     const exact_scene *scene;
     exact_scratch scratch;
+    uint64_t fast, slow; /* statistics: candidate tests the fast path decided, and not */
+    /* The fast path's models (exact_fast.h) for the line of the last test
+     * (key: o, d; key_t: its t_in), valid while its voxels stay in one
+     * coarse cell: candidate k of the cell has one when bit k of `have` is
+     * set. */
+    double key[6], key_t;
+    uint32_t key_slot, have;
+    exact_model model[EXACT_MODELS];
 } exact_worker;
 
 int exact_worker_init(exact_worker *w, const exact_scene *es); /* 0, or -1: out of memory */

@@ -175,6 +175,8 @@ static int check_args(const render_args *o)
         return diag_usage_error(usage_text, "%s", "--views and --orbit cannot be combined");
     if (o->views_path && o->base.out)
         return diag_usage_error(usage_text, "%s", "-o goes into the views file with --views");
+    if (o->refine && o->base.exact) /* each places the hits its own way */
+        return diag_usage_error(usage_text, "%s", "--refine and --exact cannot be combined");
     if (!o->views_path && !o->base.out && !o->info)
         return diag_usage_error(usage_text, "%s", "no output: give -o OUT.png or --views FILE");
     int pattern = o->orbit ? views_check_pattern(o->base.out) : 0;
@@ -273,7 +275,14 @@ static int load_views_file(const render_args *o, const views_view *base, char **
         diag_path_error(o->views_path, "no views");
         return EXIT_USAGE;
     }
-    return EXIT_OK;
+    int bad = 0;
+    for (size_t k = 0; o->refine && k < *nviews; k++)
+        if ((*list)[k].exact) {
+            report_line(&rc, (*list)[k].line,
+                        "--exact and --refine (on the command line) cannot be combined");
+            bad = 1;
+        }
+    return bad ? EXIT_USAGE : EXIT_OK;
 }
 
 /* Maps the .oct file (and prints its summary with --info). Returns EXIT_OK

@@ -301,6 +301,102 @@ static void test_roots_on_faces(void **state)
     built_free(&b);
 }
 
+/* The fast path (render/exact_fast.c) against the fallback alone (the
+ * same scene with every candidate's Hessian bound off): the same hits and
+ * misses; the same t and normal, bit for bit, for most rays, and otherwise
+ * t within 2^-46 of it and normals within 1e-9: where the double evaluation of f
+ * changes sign more than once inside its rounding noise, the two brackets
+ * may close on different sign changes (RENDER.md, "The fast path"; a few
+ * ulps of the voxel-local t, often the same t on the caller's ray). Rays: camera rays, grazing rays along the silhouette, and
+ * axis-aligned rays (zero direction components). */
+static void fast_vs_fallback(const char *text, const double target[3], double min_fast)
+{
+    built b;
+    build(text, 7, EXACT_CELL_DEPTH, &b);
+    exact_scene off = b.es;
+    off.cand = malloc(b.es.ncand * sizeof *off.cand + 1);
+    assert_non_null(off.cand);
+    memcpy(off.cand, b.es.cand, b.es.ncand * sizeof *off.cand);
+    for (uint32_t k = 0; k < off.ncand; k++)
+        for (int e = 0; e < 6; e++)
+            off.cand[k].hmag[e] = INFINITY;
+    exact_worker w1, w2;
+    assert_int_equal(exact_worker_init(&w1, &b.es), 0);
+    assert_int_equal(exact_worker_init(&w2, &off), 0);
+    trace_opts o1 = {b.tree->levels, 0, &w1}, o2 = {b.tree->levels, 0, &w2};
+    camera cam;
+    look(&cam, eye_std, target, 64);
+    unsigned hits = 0, same = 0;
+    for (unsigned k = 0; k < 64 * 64 + 3 * 400; k++) {
+        double eye[3], dir[3];
+        if (k < 64 * 64) {
+            memcpy(eye, cam.eye, sizeof eye);
+            camera_ray(&cam, k % 64, k / 64, dir);
+        } else if (k < 64 * 64 + 400) { /* grazing the unit-ish silhouette along +y */
+            const double u = (double)(k - 64 * 64) / 400.0;
+            eye[0] = 0.3 + 0.6 * u;
+            eye[1] = -1.5;
+            eye[2] = 0.05 * sin(40.0 * u);
+            dir[0] = 0.0;
+            dir[1] = 1.0;
+            dir[2] = 1e-3 * cos(17.0 * u);
+        } else { /* along the axes, from starts on a line */
+            const unsigned j = k - 64 * 64 - 400, ax = j % 3;
+            const double u = (double)(j / 3) / 400.0 * 3.0;
+            for (unsigned a = 0; a < 3; a++) {
+                eye[a] = a == ax ? -1.5 : -0.9 + 1.8 * (a == (ax + 1) % 3 ? u : 1.0 - u);
+                dir[a] = a == ax ? 1.0 : 0.0;
+            }
+        }
+        trace_hit h1, h2;
+        trace_ray_cast(b.tree, &o1, eye, dir, &h1);
+        trace_ray_cast(b.tree, &o2, eye, dir, &h2);
+        if (h1.hit != h2.hit)
+            fail_msg("%s: ray %u: hit %d, fallback %d (t %.17g / %.17g)", text, k, h1.hit,
+                     h2.hit, h1.t, h2.t);
+        if (!h1.hit)
+            continue;
+        hits++;
+        /* (two local roots a few ulps apart may give one t on the caller's ray) */
+        if (h1.t == h2.t && !memcmp(h1.normal, h2.normal, sizeof h1.normal)) {
+            same++;
+            assert_int_equal(h1.surface, h2.surface);
+            continue;
+        }
+        if (!(fabs(h1.t - h2.t) <= 0x1p-46 * h1.t)) /* (64 ulps at most) */
+            fail_msg("%s: ray %u: t %.17g, fallback %.17g", text, k, h1.t, h2.t);
+        for (int a = 0; a < 3; a++)
+            assert_true(fabs((double)h1.normal[a] - (double)h2.normal[a]) <= 1e-9);
+    }
+    if (getenv("EXACT_VERBOSE"))
+        printf("%u hits, %u the same; fast %llu, slow %llu\n", hits, same,
+               (unsigned long long)w1.fast, (unsigned long long)w1.slow);
+    assert_true(hits > 500);
+    assert_true(same * 2 >= hits);
+    assert_true(w2.fast == 0);
+    assert_true((double)w1.fast >= min_fast * (double)(w1.fast + w1.slow));
+    exact_worker_free(&w1);
+    exact_worker_free(&w2);
+    free(off.cand);
+    built_free(&b);
+}
+
+static void test_fast_vs_fallback(void **state)
+{
+    (void)state;
+    static const double mid[3] = {0.5, 0.5, 0.5};
+    fast_vs_fallback("bounds -1 -1 -1 1 1 1\nsurface x^2 + y^2 + z^2 - 0.64\n", centre, 0.95);
+    fast_vs_fallback("bounds -0.5 -0.5 -0.5 1.5 1.5 1.5\nsurface exp(-3.25*((x-0.78)^2+"
+                     "(y-0.78)^2+(z-0.78)^2)) + exp(-3.25*((x-0.23)^2+(y-0.23)^2+(z-0.23)^2))"
+                     " - 0.9\n",
+                     mid, 0.95);
+    /* creases: the cells along them keep the fallback */
+    fast_vs_fallback("bounds -1.1 -1.1 -1.1 1.1 1.1 1.1\n"
+                     "surface max(max(abs(x), abs(y), abs(z)) - 0.8, x^2 + y^2 + z^2 - 1.0,"
+                     " 0.16 - min(x^2 + y^2, y^2 + z^2, z^2 + x^2))\n",
+                     centre, 0.15);
+}
+
 /* The coarse cells: a far surface is no candidate in a cell it cannot
  * reach, and a long sum of far blobs is pruned to a few instructions. */
 static void test_cells_prune(void **state)
@@ -343,6 +439,7 @@ int main(void)
         cmocka_unit_test(test_undefined_vs_refcast),
         cmocka_unit_test(test_impls_agree),
         cmocka_unit_test(test_roots_on_faces),
+        cmocka_unit_test(test_fast_vs_fallback),
         cmocka_unit_test(test_cells_prune),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

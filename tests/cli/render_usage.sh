@@ -31,6 +31,17 @@ expect2 "no output" x.oct
 expect2 "one integer conversion" x.oct -o "$T/f.png" --orbit 3
 expect2 "cannot be combined" x.oct --views "$T/v" --orbit 3
 grep -q 'usage: render' "$T/err" || fail "no usage after an error"
+# --refine and --exact place hits each its own way: not both
+expect2 "render: --refine and --exact cannot be combined" x.oct -o "$T/a.png" --refine --exact
+expect2 "render: --refine and --exact cannot be combined" x.oct -o "$T/a.png" --exact --refine
+[ -e "$T/a.png" ] && fail "--refine --exact wrote an image"
+printf '%s\n' "-o $T/r1.png" "-o $T/r2.png --exact" > "$T/rviews"
+"$R" x.oct --views "$T/rviews" --refine >"$T/out" 2>"$T/err"; rc=$?
+[ $rc -eq 2 ] || fail "--refine with a views line --exact: exit $rc"
+grep -q "^$T/rviews:2: --exact and --refine (on the command line) cannot be combined" "$T/err" ||
+    { cat "$T/err"; fail "no FILE:2: for --exact under --refine"; }
+grep -q "^$T/rviews:1: " "$T/err" && fail "line 1 (no --exact) reported"
+[ -e "$T/r1.png" ] && fail "a view was rendered despite --exact under --refine"
 
 printf '%s\n' "-o $T/ok.png" "-o $T/b.png --eye 1,2" "# fine" "--fov 10" > "$T/views"
 "$R" x.oct --views "$T/views" >"$T/out" 2>"$T/err"; rc=$?

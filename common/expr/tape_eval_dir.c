@@ -1,0 +1,157 @@
+/* tape_eval_dir: f with its derivative along one direction, at a point
+ * (double) and over a box (intervals); see tape_dir.h. The rules are those
+ * of tape_eval_grad and tape_eval_interval_grad with one tangent instead of
+ * three. */
+#include "common/expr/tape_dir.h"
+
+#include "common/expr/tape_int.h"
+
+double tape_eval_dir(const tape *t, const double p[3], const double d[3], double *deriv,
+                     tape_dir1 *s)
+{
+    const tape_insn *in = t->insn;
+    const tape_const *k = t->konst;
+    for (uint32_t i = 0, n = t->n; i < n; i++) {
+        tape_dir1 *r = &s[i];
+        const tape_dir1 a = s[slot_a(&in[i])], c = s[slot_b(&in[i])];
+        switch ((tape_op)in[i].op) {
+        case TAPE_CONST: r->v = k[in[i].a].v; r->d = 0.0; break;
+        case TAPE_X: case TAPE_Y: case TAPE_Z:
+            r->v = p[in[i].op - TAPE_X];
+            r->d = d[in[i].op - TAPE_X];
+            break;
+        case TAPE_NEG: r->v = -a.v; r->d = -a.d; break;
+        case TAPE_SQUARE: r->v = a.v * a.v; r->d = a.d * (2.0 * a.v); break;
+        case TAPE_SQRT: r->v = sqrt(a.v); r->d = a.d * (0.5 / r->v); break;
+        case TAPE_EXP: r->v = exp(a.v); r->d = a.d * r->v; break;
+        case TAPE_LOG: r->v = log(a.v); r->d = a.d * (1.0 / a.v); break;
+        case TAPE_ABS: r->v = fabs(a.v); r->d = a.v < 0.0 ? -a.d : a.d; break;
+        case TAPE_SIN: { double sv, cv; point_sincos(a.v, &sv, &cv); r->v = sv; r->d = a.d * cv; break; }
+        case TAPE_COS: { double sv, cv; point_sincos(a.v, &sv, &cv); r->v = cv; r->d = a.d * -sv; break; }
+        case TAPE_TAN: r->v = tan(a.v); r->d = a.d * (1.0 + r->v * r->v); break;
+        case TAPE_ADD: r->v = a.v + c.v; r->d = a.d + c.d; break;
+        case TAPE_SUB: r->v = a.v - c.v; r->d = a.d - c.d; break;
+        case TAPE_MUL: r->v = a.v * c.v; r->d = a.d * c.v + a.v * c.d; break;
+        case TAPE_DIV: r->v = a.v / c.v; r->d = (a.d - r->v * c.d) / c.v; break;
+        case TAPE_MIN:
+        case TAPE_MAX: {
+            const double v = in[i].op == TAPE_MIN ? point_min(a.v, c.v) : point_max(a.v, c.v);
+            r->d = (v == a.v || v != v) ? a.d : c.d;
+            r->v = v;
+            break;
+        }
+        case TAPE_POWC: {
+            const double e = k[in[i].b].v;
+            r->v = pow(a.v, e);
+            r->d = a.d * (e * pow(a.v, e - 1.0));
+            break;
+        }
+        case TAPE_NOPS: r->v = NAN; r->d = NAN; break;
+        }
+    }
+    *deriv = s[t->root].d;
+    return s[t->root].v;
+}
+
+static int is_zero(interval a) { return a.lo == 0.0 && a.hi == 0.0; }
+static int is_finite(interval a) { return isfinite(a.lo) && isfinite(a.hi); } /* quiet: no trap */
+static interval ipt(double x) { interval r = {x, x}; return r; }
+
+/* interval_mul where an exact zero factor times a finite one is [0, 0] (as
+ * tape_eval_interval_grad's dmul): the derivative of a constant. */
+INTERVAL_INLINE interval dmul(interval a, interval b, unsigned *f)
+{
+    if ((is_zero(a) && is_finite(b)) || (is_zero(b) && is_finite(a)))
+        return ipt(0.0);
+    return interval_mul(a, b, f);
+}
+
+interval tape_eval_interval_dir(const tape *t, const interval box[3], const double d[3],
+                                interval *deriv, tape_idir1 *s, unsigned *flags)
+{
+    const tape_insn *in = t->insn;
+    const tape_const *k = t->konst;
+    unsigned f = 0;
+    for (uint32_t i = 0, n = t->n; i < n; i++) {
+        tape_idir1 *r = &s[i];
+        const tape_idir1 a = s[slot_a(&in[i])], c = s[slot_b(&in[i])];
+        switch ((tape_op)in[i].op) {
+        case TAPE_CONST:
+            r->v.lo = k[in[i].a].lo;
+            r->v.hi = k[in[i].a].hi;
+            r->d = ipt(0.0);
+            break;
+        case TAPE_X: case TAPE_Y: case TAPE_Z:
+            r->v = box[in[i].op - TAPE_X];
+            r->d = ipt(d[in[i].op - TAPE_X]);
+            break;
+        case TAPE_NEG: r->v = interval_neg(a.v); r->d = interval_neg(a.d); break;
+        case TAPE_SQUARE:
+            r->v = interval_sqr(a.v, &f);
+            r->d = dmul(a.d, interval_mul(ipt(2.0), a.v, &f), &f);
+            break;
+        case TAPE_SQRT:
+            r->v = interval_sqrt(a.v, &f);
+            r->d = dmul(a.d, interval_div(ipt(0.5), r->v, &f), &f);
+            break;
+        case TAPE_EXP: r->v = interval_exp(a.v, &f); r->d = dmul(a.d, r->v, &f); break;
+        case TAPE_LOG:
+            r->v = interval_log(a.v, &f);
+            r->d = dmul(a.d, interval_div(ipt(1.0), a.v, &f), &f);
+            break;
+        case TAPE_ABS: {
+            r->v = interval_abs(a.v);
+            const interval m = a.v.lo >= 0.0   ? ipt(1.0)
+                               : a.v.hi <= 0.0 ? ipt(-1.0)
+                                               : (interval){-1.0, 1.0};
+            r->d = dmul(a.d, m, &f);
+            break;
+        }
+        case TAPE_SIN: r->v = interval_sin(a.v, &f); r->d = dmul(a.d, interval_cos(a.v, &f), &f); break;
+        case TAPE_COS:
+            r->v = interval_cos(a.v, &f);
+            r->d = dmul(a.d, interval_neg(interval_sin(a.v, &f)), &f);
+            break;
+        case TAPE_TAN:
+            r->v = interval_tan(a.v, &f);
+            r->d = dmul(a.d, interval_add(ipt(1.0), interval_sqr(r->v, &f), &f), &f);
+            break;
+        case TAPE_ADD: r->v = interval_add(a.v, c.v, &f); r->d = interval_add(a.d, c.d, &f); break;
+        case TAPE_SUB: r->v = interval_sub(a.v, c.v, &f); r->d = interval_sub(a.d, c.d, &f); break;
+        case TAPE_MUL:
+            r->v = interval_mul(a.v, c.v, &f);
+            r->d = interval_add(dmul(a.d, c.v, &f), dmul(a.v, c.d, &f), &f);
+            break;
+        case TAPE_DIV:
+            r->v = interval_div(a.v, c.v, &f);
+            r->d = interval_div(interval_sub(a.d, dmul(r->v, c.d, &f), &f), c.v, &f);
+            break;
+        case TAPE_MIN:
+        case TAPE_MAX: {
+            const int is_min = in[i].op == TAPE_MIN;
+            r->v = is_min ? interval_min(a.v, c.v) : interval_max(a.v, c.v);
+            if (a.v.hi < c.v.lo)
+                r->d = is_min ? a.d : c.d;
+            else if (c.v.hi < a.v.lo)
+                r->d = is_min ? c.d : a.d;
+            else
+                r->d = interval_hull(a.d, c.d);
+            break;
+        }
+        case TAPE_POWC: {
+            const double e = k[in[i].b].v;
+            r->v = interval_powc(a.v, e, &f);
+            r->d = dmul(a.d, interval_mul(ipt(e), interval_powc(a.v, e - 1.0, &f), &f), &f);
+            break;
+        }
+        case TAPE_NOPS:
+            r->v = interval_nan();
+            r->d = interval_nan();
+            f |= INTERVAL_MAYBE_NAN;
+            break;
+        }
+    }
+    *flags = f;
+    *deriv = s[t->root].d;
+    return s[t->root].v;
+}

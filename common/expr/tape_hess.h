@@ -1,0 +1,39 @@
+/* tape_hess: an enclosure of f's Hessian over a box (second-order
+ * forward-mode AD in interval arithmetic, outward rounding as interval.h;
+ * tape_eval_interval_hess.c), for a bound on the second derivative of f
+ * along any line through the box. */
+#ifndef TAPE_HESS_H
+#define TAPE_HESS_H
+
+#include "common/expr/tape.h"
+
+/* Entries of a symmetric 3 x 3 matrix: xx, xy, xz, yy, yz, zz. */
+enum { TAPE_HXX, TAPE_HXY, TAPE_HXZ, TAPE_HYY, TAPE_HYZ, TAPE_HZZ, TAPE_HN };
+
+/* Slot scratch of the Hessian evaluator: value, gradient, Hessian. */
+typedef struct tape_ihess {
+    interval v, g[3], h[TAPE_HN];
+} tape_ihess;
+
+/* Set in *flags (besides INTERVAL_MAYBE_NAN) when f may have a kink in the
+ * box: abs of an operand whose enclosure holds 0 inside, or min/max whose
+ * operands' enclosures overlap. There f is not twice differentiable and the
+ * Hessian enclosure means nothing. */
+enum { TAPE_HESS_KINK = 2u };
+
+/* Enclosures of f, its gradient and its Hessian over the box: for every p
+ * in the box, the Hessian of f at p lies in hess[] when *flags is 0 (f is
+ * then defined and twice differentiable on the whole box). `slots`: t->n
+ * elements. */
+interval tape_eval_interval_hess(const tape *t, const interval box[3], interval grad[3],
+                                 interval hess[TAPE_HN], tape_ihess *slots, unsigned *flags);
+
+/* The magnitudes max |h| of the Hessian enclosure's entries over the box
+ * (mag[TAPE_HN]), so that |d^T Hess f(p) d| <= sum over i, j of mag_ij
+ * |d_i| |d_j| for every p in the box and every d. All +inf when the
+ * evaluation is flagged (undefined, kink) or an entry is not finite.
+ * Returns 1 when the magnitudes are finite, else 0. */
+int tape_hess_mag(const tape *t, const interval box[3], tape_ihess *slots,
+                  double mag[TAPE_HN]);
+
+#endif

@@ -1,0 +1,57 @@
+/* exact_fast: the certified fast path of the exact hit test in one voxel
+ * (RENDER.md, "--exact", "The fast path"): one interval evaluation of g and
+ * g' at a point of the line and a bound on |g''| over the coarse cell decide
+ * the common cases by Taylor's theorem, for every voxel of the cell along
+ * the line; a Newton step inside the certified bracket and a sign change at
+ * adjacent doubles place the root. What it cannot decide is left to
+ * exact_first_root. */
+#ifndef EXACT_FAST_H
+#define EXACT_FAST_H
+
+#include "common/expr/tape.h"
+#include "render/exact_hit.h"
+
+enum {
+    EXACT_FAST_UNDECIDED = 0, /* use exact_first_root */
+    EXACT_FAST_NONE = 1,      /* certified: no root of f on the span */
+    EXACT_FAST_ROOT = 2,      /* the root, converged to adjacent doubles */
+};
+
+/* The bound on |g''(t)| = |d^T Hess f d| along the line's direction d from
+ * the magnitudes of a Hessian enclosure (tape_hess_mag) over a box holding
+ * every point tested, rounded up; +inf when those are. */
+double exact_fast_curv(const double mag[6], const double d[3]);
+
+/* A first-order model of g at m: enclosures of g(m) and g'(m) (over the
+ * outward-rounded box of the point o + m d). */
+typedef struct exact_model {
+    double m;
+    interval g, dg;
+} exact_model;
+
+/* Fills *model at m: 1, or 0 when the evaluation is flagged (no model). */
+int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
+                     exact_model *model);
+
+/* The first root of g(t) = f(o + t d) on [a, b] (a <= b, finite) decided
+ * by Taylor's theorem from the model (at any m whose point lies in a box,
+ * convex, holding the segment's points, over which `curv` bounds |g''|):
+ * EXACT_FAST_NONE when g certainly has no root there; EXACT_FAST_ROOT with
+ * *root when g is certified monotone on [a, b] with certified opposite
+ * signs at the ends, and the double evaluation of g (tape_eval, as
+ * exact_first_root) changes sign between *root and an adjacent double (the
+ * end with the smaller |g|, the lower on a tie, as exact_refine; or a point
+ * where it is 0); otherwise EXACT_FAST_UNDECIDED. */
+int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                      double curv, const exact_model *model, double *root);
+
+/* exact_fast_decide with the caller's model (*have: it holds one, for this
+ * line and a box as above) if that decides; else, unless the model's m is
+ * in [a, b] already, with a new model at the midpoint (*model and *have
+ * updated). EXACT_FAST_UNDECIDED when curv is +inf. (No interval of f over
+ * the segment first: one model decides the voxels of the whole cell along
+ * the line that it can, for the cost of about one such interval.) */
+int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                    double curv, exact_model *model, int *have, double *root);
+
+#endif
