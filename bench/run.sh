@@ -39,6 +39,7 @@ full)
     echo "usage: bench/run.sh quick|full" >&2; exit 2 ;;
 esac
 SECTIONS=${SECTIONS:-"main speed accuracy sweep fig4 images pov shard eval"}
+REPORT=${REPORT:-README.md}
 want() { case " $SECTIONS " in *" $1 "*) return 0 ;; esac; return 1; }
 D=$(dirname "$0")
 . "$D/lib.sh"
@@ -120,7 +121,7 @@ render_views() { # OCT SCENE LEVELS MODE(plain|refine|exact) [--split K]: CSV ro
               --normals "$WORK/$name.n.pfm" "$WORK/ref.$s.$name.n.pfm" --csv)
         mr=$(awk -v ms="$ms" -v n="$SIZE" 'BEGIN { printf "%.3f", n * n / ms / 1e3 }')
         echo "$PROV,$s,$L,$name,$SIZE,$mode,$ms,$mr,$err" >>"$REND"
-        echo "  render $s levels $L $name $mode: $ms ms ($mr Mrays/s); mean,p99,max,hitmiss,nmean,np99 = $err"
+        echo "  render $s levels $L $name $mode: $ms ms ($mr Mrays/s); mean,p99,max,hitmiss,nmean,np99,nmax,nan = $err"
     done
 }
 
@@ -154,8 +155,8 @@ fi
 # wall, 200 % = both cores busy to the end), one run each, full records and
 # --shell-only; the shell: voxels kept over the voxels the surface really
 # passes through (bench/shellratio), and the records' errors (bench/normalerr) ----
-speed_run() { # SCENE LEVELS [FLAGS]: prints "seconds voxels mvox_s cpu_pct"
-    o="$WORK/speed.oct" s=$1 L=$2; shift 2
+speed_run() { # SCENE LEVELS OUT [FLAGS]: prints "seconds voxels mvox_s cpu_pct"
+    s=$1 L=$2 o=$3; shift 3
     if [ -x /usr/bin/time ]; then
         /usr/bin/time -f "time %e %U %S" "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" \
             >"$WORK/rlog" 2>&1
@@ -165,7 +166,6 @@ speed_run() { # SCENE LEVELS [FLAGS]: prints "seconds voxels mvox_s cpu_pct"
         "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" >"$WORK/rlog" 2>&1
         sec=$(sed -n 's/.*; \([0-9.]*\) s, peak memory.*/\1/p' "$WORK/rlog") cpu=nan
     fi
-    rm -f "$o"
     v=$(sed -n 's/.* \([0-9]*\) voxels, [0-9]* nodes.*/\1/p' "$WORK/rlog")
     echo "$sec $v $(awk -v v="$v" -v t="$sec" 'BEGIN { printf "%.2f", (t > 0 ? v / t / 1e6 : 0) }') $cpu"
 }
@@ -175,9 +175,11 @@ if want speed; then
     echo "$PROVH,scene,levels,kept,real,ratio,lost,voxels_near,voxels_missed,normal_mean_deg,normal_p99_deg,normal_max_deg,offset_mean_vox,offset_p99_vox,offset_max_vox" >"$SHELL"
     for s in $SPEED_SCENES; do
         for L in $SPEED_LEVELS; do
-            set -- $(speed_run "$s" "$L")
+            set -- $(speed_run "$s" "$L" "$WORK/speed.oct")
+            rm -f "$WORK/speed.oct"
             sec=$1 v=$2 mv=$3 cpu=$4
-            set -- $(speed_run "$s" "$L" --shell-only)
+            # the level sweep uses this file again rather than rasterize it twice
+            set -- $(speed_run "$s" "$L" "$WORK/shell.$s.$L.oct" --shell-only)
             echo "$PROV,$s,$L,$sec,$v,$mv,$cpu,$1,$3,$4" >>"$SPEED"
             echo "  rasterize speed $s levels $L: $sec s, $v voxels, $mv M voxels/s, CPU $cpu %; --shell-only $1 s, $3 M voxels/s, CPU $4 %"
         done
@@ -198,6 +200,7 @@ fi
 export BIN TOOLS RES WORK PROV PROVH REPS NVIEWS
 want accuracy && ACC_SCENES=$ACC_SCENES ACC_LEVELS=$ACC_LEVELS ACC_SIZE=$ACC_SIZE sh "$D/accuracy.sh"
 want sweep && SWEEP_SCENES=$SWEEP_SCENES SWEEP_LEVELS=$SWEEP_LEVELS SWEEP_SIZE=$SWEEP_SIZE sh "$D/sweep.sh"
+rm -f "$WORK"/shell.*.oct
 
 # ---- Figure 4: both blobs at FIG_LEVELS, sizes x splits 4..7 ----
 if want fig4; then
@@ -294,7 +297,7 @@ else
 fi
 want fig4 && sh "$D/fig4.sh" "$RES/figure4.csv" >"$RES/figure4.md"
 if want eval; then
-    sh "$D/eval.sh" >"$RES/eval.txt" 2>&1 || echo "bench: eval.sh failed (see $RES/eval.txt)"
+    BIN=$TOOLS sh "$D/eval.sh" >"$RES/eval.txt" 2>&1 || echo "bench: eval.sh failed (see $RES/eval.txt)"
 fi
-[ "$MODE" = full ] && sh "$D/report.sh" "$RES" README.md
+[ "$MODE" = full ] && [ "$REPORT" != none ] && sh "$D/report.sh" "$RES" "$REPORT"
 echo "bench: $MODE done in $(( $(date +%s) - T0 )) s; results in $RES"
