@@ -161,7 +161,7 @@ if has rastspeed; then
     echo "the records (normals and planes) and with \`--shell-only\`, and the CPU use (user + system over"
     echo "wall: 200 % keeps both cores busy). Targets: ≥ 10 M voxels/s, ≥ 25 with \`--shell-only\`"
     echo "(✓ met, ✗ not met)."
-    awk -F, 'NR > 1 && $8 > 60 { printf "%s %s levels %d took %.0f s (over a minute)", n++ ? ";" : "", $6, $7, $8 }
+    awk -F, 'NR > 1 && $8 > 60 { printf "%s%s levels %d %.0f s", n++ ? ", " : "Runs over a minute: ", $6, $7, $8 }
         END { if (n) print "." }' "$RES/rastspeed.csv"
     echo
     echo "| scene | levels | seconds | voxels | M voxels/s (≥ 10) | CPU % | --shell-only s | M voxels/s (≥ 25) | CPU % |"
