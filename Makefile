@@ -4,8 +4,11 @@
 #   make test            every cmocka suite and CLI test (-O2 build); make check
 #                        is the same
 #   make test SANITIZE=1 the same under ASan + UBSan, no recovery
-#   make demo            rasterize and render the paper's scenes into demo/*.png
-#   make bench           benchmark (see bench/README.md)
+#   make demo            rasterize every example and render it into demo/: the
+#                        paper's plain rule and --aa 4 --shadows --ao 16 --exact
+#                        (DOCS=1: the README's pictures in docs/images/ too)
+#   make bench           benchmark, full (make bench-quick: short; see
+#                        bench/README.md)
 #   make fuzz            libFuzzer targets for a bounded time (clang)
 #   make install         programs and man pages under DESTDIR/PREFIX
 #                        (default /usr/local); make uninstall removes them

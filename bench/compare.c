@@ -30,9 +30,12 @@ int compare_depth(const float *a, const float *b, size_t n, double voxel, const 
         free(ang);
         return -1;
     }
-    size_t both = 0, dis = 0, nang = 0;
-    double sum = 0.0, mx = 0.0, asum = 0.0;
+    size_t both = 0, dis = 0, nang = 0, nan = 0;
+    double sum = 0.0, mx = 0.0, asum = 0.0, amx = 0.0;
     for (size_t i = 0; i < n; i++) {
+        const float *p = na ? na + 3 * i : NULL;
+        int bad = isnan(a[i]) || (p && (isnan(p[0]) || isnan(p[1]) || isnan(p[2])));
+        nan += (size_t)bad;
         int ha = isfinite(a[i]), hb = isfinite(b[i]);
         if (ha != hb) {
             dis++;
@@ -45,8 +48,8 @@ int compare_depth(const float *a, const float *b, size_t n, double voxel, const 
         sum += e;
         if (e > mx)
             mx = e;
-        if (ang) {
-            const float *p = na + 3 * i, *q = nb + 3 * i;
+        if (ang && !bad) {
+            const float *q = nb + 3 * i;
             double d = (double)p[0] * q[0] + (double)p[1] * q[1] + (double)p[2] * q[2];
             double lp = sqrt((double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2]);
             double lq = sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2]);
@@ -55,6 +58,8 @@ int compare_depth(const float *a, const float *b, size_t n, double voxel, const 
                 double deg = acos(c > 1.0 ? 1.0 : c) * 180.0 / M_PI;
                 ang[nang++] = deg;
                 asum += deg;
+                if (deg > amx)
+                    amx = deg;
             }
         }
     }
@@ -66,6 +71,8 @@ int compare_depth(const float *a, const float *b, size_t n, double voxel, const 
     out->p99 = percentile(err, both, 0.99);
     out->nmean = nang ? asum / (double)nang : NAN;
     out->np99 = ang ? percentile(ang, nang, 0.99) : NAN;
+    out->nmax = nang ? amx : NAN;
+    out->nan = nan;
     free(err);
     free(ang);
     return 0;
@@ -82,5 +89,6 @@ void compare_mask(const uint8_t *a, const float *b, size_t n, compare_stats *out
     out->pixels = n;
     out->both_hit = both;
     out->disagree = dis;
-    out->mean = out->p99 = out->max = out->nmean = out->np99 = NAN;
+    out->mean = out->p99 = out->max = out->nmean = out->np99 = out->nmax = NAN;
+    out->nan = 0;
 }

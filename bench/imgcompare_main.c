@@ -17,9 +17,11 @@ static const char usage_text[] =
     "       imgcompare --mask TEST.png REF.pfm [--csv]\n"
     "Depth errors |TEST - REF| / V over pixels both hit (mean, 99th percentile,\n"
     "max), the fraction of pixels where hit and miss disagree, and the normal\n"
-    "angle error in degrees (orientation ignored). --mask: TEST is a PNG whose\n"
-    "non-black pixels are hits; only the disagreement is measured. --csv prints\n"
-    "mean,p99,max,disagree,normal_mean,normal_p99 (nan where not measured).\n"
+    "angle error in degrees (orientation ignored), and the test pixels with a\n"
+    "NaN depth or normal. --mask: TEST is a PNG whose non-black pixels are\n"
+    "hits; only the disagreement is measured. --csv prints mean,p99,max,\n"
+    "disagree,normal_mean,normal_p99,normal_max,nan_pixels (nan where not\n"
+    "measured).\n"
     "Exit status: 0 ok, 1 run-time failure, 2 bad usage.\n";
 
 static int usage(const char *msg)
@@ -129,12 +131,14 @@ int main(int argc, char **argv)
     }
     double dis = (double)st.disagree / (double)st.pixels;
     if (csv)
-        printf("%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", st.mean, st.p99, st.max, dis, st.nmean,
-               st.np99);
+        printf("%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%zu\n", st.mean, st.p99, st.max, dis, st.nmean,
+               st.np99, st.nmax, st.nan);
     else
         printf("pixels %zu, both hit %zu; depth error (voxels): mean %.4g, p99 %.4g, max %.4g; "
-               "hit/miss disagree %.4f%%; normal error (deg): mean %.3g, p99 %.3g\n",
-               st.pixels, st.both_hit, st.mean, st.p99, st.max, 100.0 * dis, st.nmean, st.np99);
+               "hit/miss disagree %.4f%%; normal error (deg): mean %.3g, p99 %.3g, max %.3g; "
+               "NaN pixels %zu\n",
+               st.pixels, st.both_hit, st.mean, st.p99, st.max, 100.0 * dis, st.nmean, st.np99,
+               st.nmax, st.nan);
 done:
     pfm_free(&ref);
     if (!mask) {

@@ -72,9 +72,29 @@ static void test_depth_stats(void **state)
     assert_true(fabs(st.p99 - 1.5) < 1e-4);
     assert_true(fabs(st.nmean - 22.5) < 1e-3); /* 0 (flipped) and 45 degrees */
     assert_true(fabs(st.np99 - 45.0) < 1e-3);
+    assert_true(fabs(st.nmax - 45.0) < 1e-3);
+    assert_int_equal(st.nan, 0);
     const uint8_t m[4] = {1, 0, 1, 1};
     compare_mask(m, b, 4, &st);
     assert_int_equal(st.disagree, 3); /* pixels 1, 2 and 3 */
+}
+
+/* A NaN depth is a miss and counted; a NaN normal is counted and left out of
+ * the angles. */
+static void test_nan_pixels(void **state)
+{
+    (void)state;
+    const float a[3] = {NAN, 2.0f, 3.0f};
+    const float b[3] = {1.0f, 2.0f, 3.0f};
+    const float na[9] = {0, 0, 1, NAN, 0, 0, 0, 1, 0};
+    const float nb[9] = {0, 0, 1, 1, 0, 0, 0, 0.70710678f, 0.70710678f};
+    compare_stats st;
+    assert_int_equal(compare_depth(a, b, 3, 1.0, na, nb, &st), 0);
+    assert_int_equal(st.nan, 2);
+    assert_int_equal(st.disagree, 1);
+    assert_int_equal(st.both_hit, 2);
+    assert_true(fabs(st.nmean - 45.0) < 1e-3);
+    assert_true(fabs(st.nmax - 45.0) < 1e-3);
 }
 
 int main(void)
@@ -82,6 +102,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pfm_round_trip),
         cmocka_unit_test(test_depth_stats),
+        cmocka_unit_test(test_nan_pixels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
