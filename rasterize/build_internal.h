@@ -129,6 +129,7 @@ typedef struct worker {
     tape_idual *islots;
     tape_dual *dslots;
     tape_dual_lanes *lslots;
+    tape_ilanes *ilslots;  /* the lane interval evaluator's scratch */
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
@@ -158,6 +159,8 @@ void worker_free(worker *wk);
 
 /* --- cell tests (cell_test.c) ------------------------------------------- */
 
+typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
+
 /* Tests the cell (depth, cell) for every surface that may cross its parent
  * (lists at index pidx). Fills the cell's lists at index depth + 1 and, when
  * it will be subdivided, its pruned tapes; box and centre receive the cell's
@@ -174,6 +177,17 @@ int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth, const 
  * its parent and fd = f(centre) in double: 1 when it proves f != 0 over box. */
 int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
                                const interval box[3], const double centre[3], double fd);
+
+/* The tests of a leaf-parent's candidate children (bit i of cand: child i,
+ * its box in cb, made) for surface s (tape t), each run on all of them at
+ * once with the lane interval evaluator; the same decisions, and counts, as
+ * centred_form_excludes_zero and cell_may_cross child by child. The first
+ * returns the children the form centred on them proves empty (G the
+ * parent's gradient enclosure, fd[4 i] f at child i's centre in double),
+ * the second those the plain interval test proves empty. */
+uint8_t centred_form_drops(worker *wk, const tape *t, const interval G[3], const child_boxes *cb,
+                           uint8_t cand, const double *fd);
+uint8_t plain_test_drops(worker *wk, const tape *t, unsigned s, const child_boxes *cb, uint8_t cand);
 
 /* The mean-value enclosures of the eight children of the node (depth, cell)
  * with box pbox, into out, the form centred on fcc. Without reuse, G and fc
@@ -192,8 +206,6 @@ typedef struct newton {
     double fg[4];         /* f and grad f at the centre */
     int step;
 } newton;
-
-typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
 
 /* f and its gradient at the voxel centre for surface s, into wk->cf.
  * Normals, plane offsets and the surface choice use the whole function, not

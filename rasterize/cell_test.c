@@ -40,8 +40,11 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
  * soundness does not rest on the margin; it only makes the skip agree with
  * the full test (docs/perf-log.md, rasterize). */
 #define RETEST_MARGIN 0.03125
-int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
-                               const interval box[3], const double centre[3], double fd)
+
+/* Whether the form centred on the voxel may exclude 0 at all: 0 when fd lies
+ * too far inside the width of G . (box - c) (see above). */
+static int centred_form_may_exclude(const interval G[3], const interval box[3],
+                                    const double centre[3], double fd)
 {
     double wlo = 0.0, whi = 0.0; /* G . (box - c) in plain double: the margin covers rounding */
     for (int k = 0; k < 3; k++) {
@@ -51,18 +54,70 @@ int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
         whi += max2(max2(p1, p2), max2(p3, p4));
     }
     double m = RETEST_MARGIN * (whi - wlo);
-    if (fd + m + wlo <= 0.0 && fd - m + whi >= 0.0) /* false on NaN or inf */
+    return !(fd + m + wlo <= 0.0 && fd - m + whi >= 0.0); /* false on NaN or inf */
+}
+
+/* The form itself, from fc = f([c]) and its flags fl. */
+static int centred_form_excludes(interval fc, unsigned fl, const interval G[3],
+                                 const interval box[3], const double centre[3])
+{
+    if (fl || interval_is_nan(fc))
         return 0;
-    interval fc;
-    if (!eval_at_centre(wk, t, centre, &fc))
-        return 0;
-    unsigned fl = 0;
     interval sum = fc;
     for (int k = 0; k < 3; k++) {
         interval r = {interval_next_down(box[k].lo - centre[k]), interval_next_up(box[k].hi - centre[k])};
         sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
     }
     return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
+}
+
+int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
+                               const interval box[3], const double centre[3], double fd)
+{
+    if (!centred_form_may_exclude(G, box, centre, fd))
+        return 0;
+    interval cb[3];
+    for (int k = 0; k < 3; k++)
+        cb[k].lo = cb[k].hi = centre[k];
+    unsigned fl = 0;
+    interval fc = tape_eval_interval(t, cb, wk->slots2, &fl);
+    wk->st.interval_evals++;
+    return centred_form_excludes(fc, fl, G, box, centre);
+}
+
+/* The enclosures over n boxes: the lane evaluator for two or more, the
+ * scalar one (the same bits) for one, where a pass over lanes would cost
+ * more than it shares. */
+static void lanes_or_one(worker *wk, const tape *t, unsigned n, interval box[][3], interval out[],
+                         unsigned fl[])
+{
+    if (n == 1)
+        out[0] = tape_eval_interval(t, box[0], wk->slots2, &fl[0]);
+    else
+        tape_eval_interval_lanes(t, n, (const interval(*)[3])box, out, fl, wk->ilslots);
+}
+
+uint8_t centred_form_drops(worker *wk, const tape *t, const interval G[3], const child_boxes *cb,
+                           uint8_t cand, const double *fd)
+{
+    interval pts[8][3], out[8];
+    unsigned fl[8], lane[8], n = 0;
+    for (unsigned i = 0; i < 8; i++) {
+        if (!((cand >> i) & 1) || !centred_form_may_exclude(G, cb->box[i], cb->centre[i], fd[4 * i]))
+            continue;
+        for (int k = 0; k < 3; k++)
+            pts[n][k].lo = pts[n][k].hi = cb->centre[i][k];
+        lane[n++] = i;
+    }
+    if (!n)
+        return 0;
+    lanes_or_one(wk, t, n, pts, out, fl);
+    wk->st.interval_evals += n;
+    uint8_t drop = 0;
+    for (unsigned l = 0; l < n; l++)
+        if (centred_form_excludes(out[l], fl[l], G, cb->box[lane[l]], cb->centre[lane[l]]))
+            drop |= (uint8_t)(1u << lane[l]);
+    return drop;
 }
 
 /* Kalra-Barr: |f(p) - f(c)| <= sum_k sup|df/dk| * r_k over the box. 1 when
@@ -116,6 +171,41 @@ static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned dep
         return 0;
     }
     return 1;
+}
+
+uint8_t plain_test_drops(worker *wk, const tape *t, unsigned s, const child_boxes *cb, uint8_t cand)
+{
+    const build_ctx *c = wk->c;
+    interval boxes[8][3], out[8];
+    unsigned fl[8], lane[8], n = 0;
+    for (unsigned i = 0; i < 8; i++)
+        if ((cand >> i) & 1) {
+            memcpy(boxes[n], cb->box[i], sizeof boxes[n]);
+            lane[n++] = i;
+        }
+    if (!n)
+        return 0;
+    lanes_or_one(wk, t, n, boxes, out, fl);
+    uint8_t drop = 0;
+    for (unsigned l = 0; l < n; l++) { /* surface_may_cross's rules, BUILD_INTERVAL */
+        interval v = out[l];
+        wk->st.interval_evals++;
+        wk->st.insns_evaluated += t->n;
+        wk->st.insns_full += c->full[s]->n;
+        int keep;
+        if (interval_is_nan(v)) {
+            wk->st.nan_cells++;
+            keep = 0;
+        } else if (fl[l]) {
+            wk->st.nan_cells++;
+            keep = v.lo <= 0.0 && v.hi >= 0.0;
+        } else {
+            keep = !(v.lo > 0.0 || v.hi < 0.0);
+        }
+        if (!keep)
+            drop |= (uint8_t)(1u << lane[l]);
+    }
+    return drop;
 }
 
 int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,

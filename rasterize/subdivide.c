@@ -55,14 +55,41 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
     }
 }
 
+/* For a leaf-parent, after leaf_centres: the children whose re-tests drop
+ * them, per surface (index k as in ok): the form centred on each voxel, then
+ * on a tape with a kink the plain interval test too (there the gradient
+ * enclosure spans both branches and the forms are loose where the interval
+ * is not: csg, gyroid). Each test runs on all the children at once. Bit i of
+ * centred[k] marks a drop by the form, of plain[k] by the plain test. */
+static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+                         child_boxes *cb, uint8_t *centred, uint8_t *plain)
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k];
+        centred[k] = plain[k] = 0;
+        if (!ok[k])
+            continue;
+        uint8_t cand = 0;
+        for (unsigned i = 0; i < 8; i++)
+            if (!(T[k][i].lo > 0.0 || T[k][i].hi < 0.0) && child_box(cb, i))
+                cand |= (uint8_t)(1u << i);
+        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+        centred[k] = centred_form_drops(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], cb, cand,
+                                        wk->cf8 + (size_t)s * 32);
+        if (wk->kinked[(size_t)pidx * ns + s])
+            plain[k] = plain_test_drops(wk, t, s, cb, (uint8_t)(cand & ~centred[k]));
+    }
+}
+
 /* Whether the tests a child of the node (depth) faces after the node's
  * mean-value form (ok: that form was available for surface s) drop it.
  * Without the form, or on coarse cells, the plain interval test. At the
- * voxels, the form centred on the voxel, then on a tape with a kink the
- * plain interval test too: there the gradient enclosure spans both branches
- * and the forms are loose where the interval is not (csg, gyroid). */
+ * voxels, the re-tests leaf_retests made (retest: bit 0 a drop by the form
+ * centred on the voxel, bit 1 by the plain test). */
 static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const interval box[3],
-                         const double centre[3])
+                         const double centre[3], unsigned retest)
 {
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
@@ -75,12 +102,8 @@ static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const i
     }
     if (depth + 1 < c->levels)
         return 0;
-    if (centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], box, centre,
-                                   centre_fg(wk, s, centre)[0])) {
-        wk->st.taylor_drops++;
-        return 1;
-    }
-    return wk->kinked[(size_t)pidx * ns + s] && !cell_may_cross(wk, t, s, depth + 1, box, centre);
+    wk->st.taylor_drops += retest & 1;
+    return retest != 0;
 }
 
 /* The finest levels: children are tested with child_enclosures, inheriting
@@ -116,10 +139,12 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     child_boxes_init(c, depth, cell, pbox, &cb);
     int retest = depth + 1 == c->levels && depth + 1 >= MEAN_VALUE_ALONE_DEPTH;
     newton nw[8];
-    uint8_t child[8], surf[8];
+    uint8_t child[8], surf[8], centred[OCT_MAX_SURFACES], plain[OCT_MAX_SURFACES];
     unsigned np = 0;
-    if (retest)
+    if (retest) {
         leaf_centres(wk, depth, ok, T, &cb);
+        leaf_retests(wk, depth, ok, T, &cb, centred, plain);
+    }
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         const interval *box = cb.box[i];
         const double *centre = cb.centre[i];
@@ -137,7 +162,8 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
                 memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
                 wk->cf_ok[s] = 1;
             }
-            if (child_dropped(wk, depth, s, ok[k], box, centre)) {
+            unsigned rt = retest && ok[k] ? ((centred[k] >> i) & 1u) | ((plain[k] >> i) & 1u) << 1 : 0;
+            if (child_dropped(wk, depth, s, ok[k], box, centre, rt)) {
                 wk->cf_ok[s] = 0;
                 continue;
             }
