@@ -178,16 +178,22 @@ int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth, const 
 int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
                                const interval box[3], const double centre[3], double fd);
 
-/* The tests of a leaf-parent's candidate children (bit i of cand: child i,
- * its box in cb, made) for surface s (tape t), each run on all of them at
- * once with the lane interval evaluator; the same decisions, and counts, as
- * centred_form_excludes_zero and cell_may_cross child by child. The first
- * returns the children the form centred on them proves empty (G the
- * parent's gradient enclosure, fd[4 i] f at child i's centre in double),
- * the second those the plain interval test proves empty. */
-uint8_t centred_form_drops(worker *wk, const tape *t, const interval G[3], const child_boxes *cb,
-                           uint8_t cand, const double *fd);
-uint8_t plain_test_drops(worker *wk, const tape *t, unsigned s, const child_boxes *cb, uint8_t cand);
+/* A voxel to re-test: its box, its centre, f at the centre in double. */
+typedef struct retest_item {
+    const interval *box;
+    const double *centre;
+    double fd;
+} retest_item;
+
+/* The re-tests of n voxels for surface s (tape t), run TAPE_LANES at a time
+ * with the lane interval evaluator; the same decisions, and counts, as
+ * centred_form_excludes_zero and cell_may_cross voxel by voxel. drop[j]
+ * receives 1 when voxel j is proved empty: by the form centred on it (G its
+ * parent's gradient enclosure), or by the plain interval test. */
+void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
+                        unsigned n, uint8_t *drop);
+void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,
+                      uint8_t *drop);
 
 /* The mean-value enclosures of the eight children of the node (depth, cell)
  * with box pbox, into out, the form centred on fcc. Without reuse, G and fc

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "common/expr/interval_lanes.h"
 #include "common/expr/tape.h"
 
 #define IL_CAT2(a, b) a##b
@@ -18,43 +19,6 @@
 #else
 #define TAPE_ILANES_AVX2 0
 #endif
-
-static inline uint64_t il_bits(double x)
-{
-    uint64_t u;
-    memcpy(&u, &x, sizeof u);
-    return u;
-}
-static inline double il_double(uint64_t u)
-{
-    double x;
-    memcpy(&x, &u, sizeof x);
-    return x;
-}
-/* 1 when x is neither infinite nor NaN, else 0 (a quiet test). */
-static inline uint64_t il_finite(double x) { return ((il_bits(x) >> 52) & 0x7ff) != 0x7ff; }
-/* 1 when x is finite and |x| >= DBL_MIN (not 0, not subnormal), else 0. */
-static inline uint64_t il_normal(double x) { return ((il_bits(x) >> 52) & 0x7ff) - 1 < 0x7fe; }
-/* interval__up_finite and interval__down_finite of such a normal x: the
- * bit step alone. */
-static inline double il_step_up(double x)
-{
-    uint64_t u = il_bits(x);
-    return il_double(u + (1 - ((u >> 63) << 1)));
-}
-static inline double il_step_down(double x)
-{
-    uint64_t u = il_bits(x);
-    return il_double(u - (1 - ((u >> 63) << 1)));
-}
-/* m ? a : b for m 0 or 1, on the bit patterns (vector code without
- * branches). */
-static inline double il_sel(uint64_t m, double a, double b)
-{
-    return il_double((il_bits(a) & (0 - m)) | (il_bits(b) & (m - 1)));
-}
-static inline double il_min(double a, double b) { return a < b ? a : b; } /* as interval__min2 */
-static inline double il_max(double a, double b) { return a > b ? a : b; }
 
 static inline interval il_get(const tape_ilanes *v, unsigned l)
 {
