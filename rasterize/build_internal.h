@@ -168,28 +168,22 @@ typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
                              interval box[3], double centre[3]);
 
-/* The plain test of surface s (tape t) on one cell: 0 when the cell
- * provably holds no point of it. */
-int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth, const interval box[3],
-                   const double centre[3]);
-
-/* The mean-value form centred on a voxel, with G the gradient enclosure of
- * its parent and fd = f(centre) in double: 1 when it proves f != 0 over box. */
-int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
-                               const interval box[3], const double centre[3], double fd);
-
-/* A voxel to re-test: its box, its centre, f at the centre in double. */
+/* A cell to test: its box, its centre, f at the centre in double (for the
+ * centred form). */
 typedef struct retest_item {
     const interval *box;
     const double *centre;
     double fd;
 } retest_item;
 
-/* The re-tests of n voxels for surface s (tape t), run TAPE_LANES at a time
- * with the lane interval evaluator; the same decisions, and counts, as
- * centred_form_excludes_zero and cell_may_cross voxel by voxel. drop[j]
- * receives 1 when voxel j is proved empty: by the form centred on it (G its
- * parent's gradient enclosure), or by the plain interval test. */
+/* The tests of n cells for surface s (tape t), run TAPE_LANES at a time with
+ * the lane interval evaluator (one alone with the scalar one); drop[j]
+ * receives 1 when cell j is proved empty of the surface. centred_form_drops:
+ * the mean-value form centred on each voxel, f([c]) + G . (box - c), G the
+ * parent's gradient enclosure and fd f(c) in double (cell_test.c).
+ * plain_test_drops: the plain interval test over each cell's box (no point of
+ * the surface where f is defined), on voxels or on a node's children. Same
+ * decisions and counts as testing the cells one by one. */
 void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
                         unsigned n, uint8_t *drop);
 void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,

@@ -72,20 +72,6 @@ static int centred_form_excludes(interval fc, unsigned fl, const interval G[3],
     return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
 }
 
-int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
-                               const interval box[3], const double centre[3], double fd)
-{
-    if (!centred_form_may_exclude(G, box, centre, fd))
-        return 0;
-    interval cb[3];
-    for (int k = 0; k < 3; k++)
-        cb[k].lo = cb[k].hi = centre[k];
-    unsigned fl = 0;
-    interval fc = tape_eval_interval(t, cb, wk->slots2, &fl);
-    wk->st.interval_evals++;
-    return centred_form_excludes(fc, fl, G, box, centre);
-}
-
 /* The enclosures over n boxes: the lane evaluator for two or more, the
  * scalar one (the same bits) for one, where a pass over lanes would cost
  * more than it shares. */
@@ -203,13 +189,6 @@ void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *
             drop[j0 + l] = (uint8_t)!keep;
         }
     }
-}
-
-int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
-                   const interval box[3], const double centre[3])
-{
-    unsigned flags;
-    return surface_may_cross(wk, t, s, depth, box, centre, &flags);
 }
 
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],

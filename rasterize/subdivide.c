@@ -98,24 +98,52 @@ static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, interval
     }
 }
 
-/* Whether the tests a child of the node (depth) faces after the node's
- * mean-value form (ok: that form was available for surface s) drop it.
- * Without the form, or on coarse cells, the plain interval test. At the
- * voxels, the re-tests leaf_retests made (retest: bit 0 a drop by the form
- * centred on the voxel, bit 1 by the plain test). */
-static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const interval box[3],
-                         const double centre[3], unsigned retest)
+/* Whether a child of the node (depth) takes the plain interval test for
+ * surface k after the node's mean-value form (ok: that form was available):
+ * without the form, or on coarse cells. */
+static int takes_plain_test(unsigned depth, int ok)
 {
-    const build_ctx *c = wk->c;
-    const unsigned ns = c->nsurf, pidx = depth + 1;
-    const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-    if (!ok || depth + 1 < MEAN_VALUE_ALONE_DEPTH) {
-        if (cell_may_cross(wk, t, s, depth + 1, box, centre))
-            return 0;
-        wk->st.taylor_drops += (unsigned)ok;
-        return 1;
+    return !ok || depth + 1 < MEAN_VALUE_ALONE_DEPTH;
+}
+
+/* The plain tests of the node's children (those takes_plain_test names,
+ * inside the bounds, not dropped by T), all at once: bit i of drop[k] set
+ * when the test proves child i empty of surface k. */
+static void children_plain_tests(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+                                 child_boxes *cb, uint8_t *drop)
+{
+    const unsigned ns = wk->c->nsurf, pidx = depth + 1;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0;
+        drop[k] = 0;
+        if (!takes_plain_test(depth, ok[k]))
+            continue;
+        retest_item it[8];
+        uint8_t child[8], d[8];
+        for (unsigned i = 0; i < 8; i++)
+            if (!(ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) && child_box(cb, i)) {
+                retest_item r = {cb->box[i], cb->centre[i], 0.0};
+                child[n] = (uint8_t)i;
+                it[n++] = r;
+            }
+        plain_test_drops(wk, &wk->tapes[(size_t)pidx * ns + s], s, it, n, d);
+        for (unsigned j = 0; j < n; j++)
+            drop[k] |= (uint8_t)(d[j] << child[j]);
     }
-    if (depth + 1 < c->levels)
+}
+
+/* Whether the tests a child of the node (depth) faces after the node's
+ * mean-value form (ok) drop it: the plain interval test where
+ * takes_plain_test says so (its result in plain_drop), or at the voxels the
+ * re-tests leaf_retests made (retest: bit 0 a drop by the form centred on
+ * the voxel, bit 1 by the plain test). */
+static int child_dropped(worker *wk, unsigned depth, int ok, int plain_drop, unsigned retest)
+{
+    if (takes_plain_test(depth, ok)) {
+        wk->st.taylor_drops += (unsigned)(ok && plain_drop);
+        return plain_drop;
+    }
+    if (depth + 1 < wk->c->levels)
         return 0;
     wk->st.taylor_drops += retest & 1;
     return retest != 0;
@@ -147,8 +175,9 @@ static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3]
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1, cidx = depth + 2;
     newton nw[8];
-    uint8_t child[8], surf[8], mask = 0;
+    uint8_t child[8], surf[8], mask = 0, coarse[OCT_MAX_SURFACES];
     unsigned np = 0;
+    children_plain_tests(wk, depth, ok, T, cb, coarse);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         const interval *box = cb->box[i];
         const double *centre = cb->centre[i];
@@ -167,7 +196,7 @@ static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3]
                 wk->cf_ok[s] = 1;
             }
             unsigned rt = retest && ok[k] ? ((centred[k] >> i) & 1u) | ((plain[k] >> i) & 1u) << 1 : 0;
-            if (child_dropped(wk, depth, s, ok[k], box, centre, rt)) {
+            if (child_dropped(wk, depth, ok[k], (coarse[k] >> i) & 1, rt)) {
                 wk->cf_ok[s] = 0;
                 continue;
             }

@@ -62,16 +62,22 @@ static inline interval il_add(interval a, interval b, uint64_t *ok)
     return r;
 }
 
-/* interval_mul(a, b) likewise. */
+/* 1 when x is +0 or -0. */
+static inline uint64_t il_zero(double x) { return (il_bits(x) << 1) == 0; }
+
+/* interval_mul(a, b) likewise; with finite ends, a factor that is exactly
+ * [0, 0] gives interval_mul's [+0, +0] (a zero end from a zero factor stays
+ * 0: the partials of a term without that variable). */
 static inline interval il_mul(interval a, interval b, uint64_t *ok)
 {
     uint64_t f = il_finite(a.lo) & il_finite(a.hi) & il_finite(b.lo) & il_finite(b.hi);
+    uint64_t z = (il_zero(a.lo) & il_zero(a.hi)) | (il_zero(b.lo) & il_zero(b.hi));
     double al = il_sel(f, a.lo, 1.0), ah = il_sel(f, a.hi, 1.0);
     double bl = il_sel(f, b.lo, 1.0), bh = il_sel(f, b.hi, 1.0);
     double p1 = al * bl, p2 = al * bh, p3 = ah * bl, p4 = ah * bh;
     double lo = il_min(il_min(p1, p2), il_min(p3, p4)), hi = il_max(il_max(p1, p2), il_max(p3, p4));
-    *ok &= f & il_normal(lo) & il_normal(hi);
-    interval r = {il_step_down(lo), il_step_up(hi)};
+    *ok &= f & (z | (il_normal(lo) & il_normal(hi)));
+    interval r = {il_sel(z, 0.0, il_step_down(lo)), il_sel(z, 0.0, il_step_up(hi))};
     return r;
 }
 

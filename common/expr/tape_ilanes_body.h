@@ -180,9 +180,14 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
             }
             break;
         }
-        case TAPE_X: case TAPE_Y: case TAPE_Z:
-            *r = box[op - TAPE_X];
+        case TAPE_X: case TAPE_Y: case TAPE_Z: {
+            const tape_ilanes *b = &box[op - TAPE_X];
+            LANES {
+                r->lo[l] = b->lo[l];
+                r->hi[l] = b->hi[l];
+            }
             break;
+        }
         case TAPE_NEG:
             LANES {
                 r->lo[l] = -A->hi[l];
