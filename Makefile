@@ -145,6 +145,13 @@ $(B)/hooks/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(ALLCFLAGS) -DDDA_TEST_HOOKS -MMD -MP -c $< -o $@
 
+# The AVX2 builds of the lane evaluators (common/expr/tape_ilanes.c chooses
+# at run time): these files alone get -mavx2 (no FMA), outside link-time
+# optimisation so no other code is compiled for AVX2.
+ifeq ($(ARCH),x86_64)
+$(B)/common/expr/tape_ilanes_avx2.o $(B)/common/expr/tape_lanes_avx2.o: ALLCFLAGS += -mavx2 -fno-lto
+endif
+
 # --version: VERSION plus the checkout's commit (none outside a checkout).
 # The stamp changes only when that string does, so version.o rebuilds then.
 DDA_VERSION := $(shell cat VERSION)

@@ -41,8 +41,15 @@ void test_hooks_view(unsigned view)
 }
 
 void test_hooks_tile(unsigned long long done) { render_hook(hook_view, done); }
+
+int test_hooks_portable_simd(void)
+{
+    const char *v = getenv("DDA_SIMD");
+    return v && strcmp(v, "portable") == 0;
+}
 #else
 void test_hooks_init(void) {}
 void test_hooks_view(unsigned view) { (void)view; }
 void test_hooks_tile(unsigned long long done) { (void)done; }
+int test_hooks_portable_simd(void) { return 0; }
 #endif

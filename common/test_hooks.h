@@ -11,6 +11,9 @@
  *                       view's first ray), on the thread that called
  *                       frame_render: with --threads 1 a fixed point of the
  *                       run, to change the mapped file under it
+ *     DDA_SIMD=portable the lane evaluators run their portable build even
+ *                       where the processor has AVX2 (common/expr/tape.h),
+ *                       so the tests cover every dispatched path
  * Without the macro, the release programs never read those variables. */
 #ifndef TEST_HOOKS_H
 #define TEST_HOOKS_H
@@ -23,5 +26,8 @@ void test_hooks_init(void);
  * hook), then each count of tiles done. No-ops in release builds. */
 void test_hooks_view(unsigned view);
 void test_hooks_tile(unsigned long long done);
+
+/* 1 when DDA_SIMD=portable is set (test builds); 0 in release builds. */
+int test_hooks_portable_simd(void);
 
 #endif

@@ -129,6 +129,7 @@ typedef struct worker {
     tape_idual *islots;
     tape_dual *dslots;
     tape_dual_lanes *lslots;
+    tape_ilanes *ilslots;  /* the lane interval evaluator's scratch */
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
@@ -158,6 +159,8 @@ void worker_free(worker *wk);
 
 /* --- cell tests (cell_test.c) ------------------------------------------- */
 
+typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
+
 /* Tests the cell (depth, cell) for every surface that may cross its parent
  * (lists at index pidx). Fills the cell's lists at index depth + 1 and, when
  * it will be subdivided, its pruned tapes; box and centre receive the cell's
@@ -165,15 +168,26 @@ void worker_free(worker *wk);
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
                              interval box[3], double centre[3]);
 
-/* The plain test of surface s (tape t) on one cell: 0 when the cell
- * provably holds no point of it. */
-int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth, const interval box[3],
-                   const double centre[3]);
+/* A cell to test: its box, its centre, f at the centre in double (for the
+ * centred form). */
+typedef struct retest_item {
+    const interval *box;
+    const double *centre;
+    double fd;
+} retest_item;
 
-/* The mean-value form centred on a voxel, with G the gradient enclosure of
- * its parent and fd = f(centre) in double: 1 when it proves f != 0 over box. */
-int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
-                               const interval box[3], const double centre[3], double fd);
+/* The tests of n cells for surface s (tape t), run TAPE_LANES at a time with
+ * the lane interval evaluator (one alone with the scalar one); drop[j]
+ * receives 1 when cell j is proved empty of the surface. centred_form_drops:
+ * the mean-value form centred on each voxel, f([c]) + G . (box - c), G the
+ * parent's gradient enclosure and fd f(c) in double (cell_test.c).
+ * plain_test_drops: the plain interval test over each cell's box (no point of
+ * the surface where f is defined), on voxels or on a node's children. Same
+ * decisions and counts as testing the cells one by one. */
+void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
+                        unsigned n, uint8_t *drop);
+void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,
+                      uint8_t *drop);
 
 /* The mean-value enclosures of the eight children of the node (depth, cell)
  * with box pbox, into out, the form centred on fcc. Without reuse, G and fc
@@ -192,8 +206,6 @@ typedef struct newton {
     double fg[4];         /* f and grad f at the centre */
     int step;
 } newton;
-
-typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
 
 /* f and its gradient at the voxel centre for surface s, into wk->cf.
  * Normals, plane offsets and the surface choice use the whole function, not

@@ -11,6 +11,7 @@
  * nan_cells. */
 #include <math.h>
 
+#include "common/expr/interval_lanes.h"
 #include "rasterize/build_internal.h"
 #include "rasterize/cell_geometry.h"
 
@@ -40,8 +41,11 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
  * soundness does not rest on the margin; it only makes the skip agree with
  * the full test (docs/perf-log.md, rasterize). */
 #define RETEST_MARGIN 0.03125
-int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
-                               const interval box[3], const double centre[3], double fd)
+
+/* Whether the form centred on the voxel may exclude 0 at all: 0 when fd lies
+ * too far inside the width of G . (box - c) (see above). */
+static int centred_form_may_exclude(const interval G[3], const interval box[3],
+                                    const double centre[3], double fd)
 {
     double wlo = 0.0, whi = 0.0; /* G . (box - c) in plain double: the margin covers rounding */
     for (int k = 0; k < 3; k++) {
@@ -51,18 +55,56 @@ int centred_form_excludes_zero(worker *wk, const tape *t, const interval G[3],
         whi += max2(max2(p1, p2), max2(p3, p4));
     }
     double m = RETEST_MARGIN * (whi - wlo);
-    if (fd + m + wlo <= 0.0 && fd - m + whi >= 0.0) /* false on NaN or inf */
+    return !(fd + m + wlo <= 0.0 && fd - m + whi >= 0.0); /* false on NaN or inf */
+}
+
+/* The form itself, from fc = f([c]) and its flags fl. */
+static int centred_form_excludes(interval fc, unsigned fl, const interval G[3],
+                                 const interval box[3], const double centre[3])
+{
+    if (fl || interval_is_nan(fc))
         return 0;
-    interval fc;
-    if (!eval_at_centre(wk, t, centre, &fc))
-        return 0;
-    unsigned fl = 0;
     interval sum = fc;
     for (int k = 0; k < 3; k++) {
         interval r = {interval_next_down(box[k].lo - centre[k]), interval_next_up(box[k].hi - centre[k])};
         sum = interval_add(sum, interval_mul(G[k], r, &fl), &fl);
     }
     return !fl && !interval_is_nan(sum) && (sum.lo > 0.0 || sum.hi < 0.0);
+}
+
+/* The enclosures over n boxes: the lane evaluator for two or more, the
+ * scalar one (the same bits) for one, where a pass over lanes would cost
+ * more than it shares. */
+static void lanes_or_one(worker *wk, const tape *t, unsigned n, interval box[][3], interval out[],
+                         unsigned fl[])
+{
+    if (n == 1)
+        out[0] = tape_eval_interval(t, box[0], wk->slots2, &fl[0]);
+    else
+        tape_eval_interval_lanes(t, n, (const interval(*)[3])box, out, fl, wk->ilslots);
+}
+
+void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
+                        unsigned n, uint8_t *drop)
+{
+    interval pts[TAPE_LANES][3], out[TAPE_LANES];
+    unsigned fl[TAPE_LANES], lane[TAPE_LANES], m = 0;
+    for (unsigned j = 0; j < n; j++) {
+        drop[j] = 0;
+        if (centred_form_may_exclude(G, it[j].box, it[j].centre, it[j].fd)) {
+            for (int k = 0; k < 3; k++)
+                pts[m][k].lo = pts[m][k].hi = it[j].centre[k];
+            lane[m++] = j;
+        }
+        if (m == TAPE_LANES || (m && j + 1 == n)) { /* a full pass, or the last */
+            lanes_or_one(wk, t, m, pts, out, fl);
+            wk->st.interval_evals += m;
+            for (unsigned l = 0; l < m; l++)
+                drop[lane[l]] = (uint8_t)centred_form_excludes(out[l], fl[l], G, it[lane[l]].box,
+                                                               it[lane[l]].centre);
+            m = 0;
+        }
+    }
 }
 
 /* Kalra-Barr: |f(p) - f(c)| <= sum_k sup|df/dk| * r_k over the box. 1 when
@@ -118,11 +160,35 @@ static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned dep
     return 1;
 }
 
-int cell_may_cross(worker *wk, const tape *t, unsigned s, unsigned depth,
-                   const interval box[3], const double centre[3])
+void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,
+                      uint8_t *drop)
 {
-    unsigned flags;
-    return surface_may_cross(wk, t, s, depth, box, centre, &flags);
+    const build_ctx *c = wk->c;
+    interval boxes[TAPE_LANES][3], out[TAPE_LANES];
+    unsigned fl[TAPE_LANES];
+    for (unsigned j0 = 0; j0 < n; j0 += TAPE_LANES) {
+        unsigned m = n - j0 < TAPE_LANES ? n - j0 : TAPE_LANES;
+        for (unsigned l = 0; l < m; l++)
+            memcpy(boxes[l], it[j0 + l].box, sizeof boxes[l]);
+        lanes_or_one(wk, t, m, boxes, out, fl);
+        for (unsigned l = 0; l < m; l++) { /* surface_may_cross's rules, BUILD_INTERVAL */
+            interval v = out[l];
+            wk->st.interval_evals++;
+            wk->st.insns_evaluated += t->n;
+            wk->st.insns_full += c->full[s]->n;
+            int keep;
+            if (interval_is_nan(v)) {
+                wk->st.nan_cells++;
+                keep = 0;
+            } else if (fl[l]) {
+                wk->st.nan_cells++;
+                keep = v.lo <= 0.0 && v.hi >= 0.0;
+            } else {
+                keep = !(v.lo > 0.0 || v.hi < 0.0);
+            }
+            drop[j0 + l] = (uint8_t)!keep;
+        }
+    }
 }
 
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
@@ -178,7 +244,7 @@ int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned
                      int reuse, interval out[8])
 {
     const build_ctx *c = wk->c;
-    interval half[3][2];
+    interval half[3][2], off[3][2];
     unsigned fl = 0;
     if (!reuse) {
         tape_eval_interval_grad(t, pbox, G, wk->islots, &fl);
@@ -192,13 +258,30 @@ int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned
         double m = c->origin[k] + (double)(2 * cell[k] + 1) * c->cell_edge[depth + 1];
         interval lo = {interval_next_down(pbox[k].lo - pc[k]), interval_next_up(interval_next_up(m) - pc[k])};
         interval hi = {interval_next_down(interval_next_down(m) - pc[k]), interval_next_up(pbox[k].hi - pc[k])};
-        half[k][0] = interval_mul(G[k], lo, &fl);
-        half[k][1] = interval_mul(G[k], hi, &fl);
+        off[k][0] = lo;
+        off[k][1] = hi;
     }
     /* fc + x-half, + y-half, + z-half, summed in that order for every
      * child; children that share the first terms share their partial sums
-     * (2 + 4 + 8 additions instead of 3 x 8, the same values). */
+     * (2 + 4 + 8 additions instead of 3 x 8, the same values). First with
+     * the operations' fast paths, without branches (interval_lanes.h); where
+     * one does not apply, all again with the operations themselves. */
     interval s1[2], s2[4];
+    uint64_t good = 1;
+    for (int k = 0; k < 3; k++)
+        for (int b = 0; b < 2; b++)
+            half[k][b] = il_mul(G[k], off[k][b], &good);
+    for (unsigned i = 0; i < 2; i++)
+        s1[i] = il_add(*fc, half[0][i], &good);
+    for (unsigned i = 0; i < 4; i++)
+        s2[i] = il_add(s1[i & 1], half[1][i >> 1], &good);
+    for (unsigned i = 0; i < 8; i++)
+        out[i] = il_add(s2[i & 3], half[2][i >> 2], &good);
+    if (good)
+        return 1; /* no flag: fl is 0 here, and the fast paths raise none */
+    for (int k = 0; k < 3; k++)
+        for (int b = 0; b < 2; b++)
+            half[k][b] = interval_mul(G[k], off[k][b], &fl);
     for (unsigned i = 0; i < 2; i++)
         s1[i] = interval_add(*fc, half[0][i], &fl);
     for (unsigned i = 0; i < 4; i++)

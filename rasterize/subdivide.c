@@ -55,32 +55,288 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
     }
 }
 
-/* Whether the tests a child of the node (depth) faces after the node's
- * mean-value form (ok: that form was available for surface s) drop it.
- * Without the form, or on coarse cells, the plain interval test. At the
- * voxels, the form centred on the voxel, then on a tape with a kink the
- * plain interval test too: there the gradient enclosure spans both branches
- * and the forms are loose where the interval is not (csg, gyroid). */
-static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const interval box[3],
-                         const double centre[3])
+/* For a leaf-parent, after leaf_centres: the children whose re-tests drop
+ * them, per surface (index k as in ok): the form centred on each voxel, then
+ * on a tape with a kink the plain interval test too (there the gradient
+ * enclosure spans both branches and the forms are loose where the interval
+ * is not: csg, gyroid). Each test runs on all the children at once. Bit i of
+ * centred[k] marks a drop by the form, of plain[k] by the plain test. */
+static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+                         child_boxes *cb, uint8_t *centred, uint8_t *plain)
 {
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
-    const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-    if (!ok || depth + 1 < MEAN_VALUE_ALONE_DEPTH) {
-        if (cell_may_cross(wk, t, s, depth + 1, box, centre))
-            return 0;
-        wk->st.taylor_drops += (unsigned)ok;
-        return 1;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, m = 0;
+        centred[k] = plain[k] = 0;
+        if (!ok[k])
+            continue;
+        retest_item it[8];
+        uint8_t child[8], drop[8];
+        for (unsigned i = 0; i < 8; i++)
+            if (!(T[k][i].lo > 0.0 || T[k][i].hi < 0.0) && child_box(cb, i)) {
+                retest_item r = {cb->box[i], cb->centre[i], wk->cf8[((size_t)s * 8 + i) * 4]};
+                child[n] = (uint8_t)i;
+                it[n++] = r;
+            }
+        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+        centred_form_drops(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], it, n, drop);
+        for (unsigned j = 0; j < n; j++) {
+            if (drop[j])
+                centred[k] |= (uint8_t)(1u << child[j]);
+            else { /* the plain test's candidates */
+                child[m] = child[j];
+                it[m++] = it[j];
+            }
+        }
+        if (!wk->kinked[(size_t)pidx * ns + s])
+            continue;
+        plain_test_drops(wk, t, s, it, m, drop);
+        for (unsigned j = 0; j < m; j++)
+            if (drop[j])
+                plain[k] |= (uint8_t)(1u << child[j]);
     }
-    if (depth + 1 < c->levels)
+}
+
+/* Whether a child of the node (depth) takes the plain interval test for
+ * surface k after the node's mean-value form (ok: that form was available):
+ * without the form, or on coarse cells. */
+static int takes_plain_test(unsigned depth, int ok)
+{
+    return !ok || depth + 1 < MEAN_VALUE_ALONE_DEPTH;
+}
+
+/* The plain tests of the node's children (those takes_plain_test names,
+ * inside the bounds, not dropped by T), all at once: bit i of drop[k] set
+ * when the test proves child i empty of surface k. */
+static void children_plain_tests(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+                                 child_boxes *cb, uint8_t *drop)
+{
+    const unsigned ns = wk->c->nsurf, pidx = depth + 1;
+    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0;
+        drop[k] = 0;
+        if (!takes_plain_test(depth, ok[k]))
+            continue;
+        retest_item it[8];
+        uint8_t child[8], d[8];
+        for (unsigned i = 0; i < 8; i++)
+            if (!(ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) && child_box(cb, i)) {
+                retest_item r = {cb->box[i], cb->centre[i], 0.0};
+                child[n] = (uint8_t)i;
+                it[n++] = r;
+            }
+        plain_test_drops(wk, &wk->tapes[(size_t)pidx * ns + s], s, it, n, d);
+        for (unsigned j = 0; j < n; j++)
+            drop[k] |= (uint8_t)(d[j] << child[j]);
+    }
+}
+
+/* Whether the tests a child of the node (depth) faces after the node's
+ * mean-value form (ok) drop it: the plain interval test where
+ * takes_plain_test says so (its result in plain_drop), or at the voxels the
+ * re-tests leaf_retests made (retest: bit 0 a drop by the form centred on
+ * the voxel, bit 1 by the plain test). */
+static int child_dropped(worker *wk, unsigned depth, int ok, int plain_drop, unsigned retest)
+{
+    if (takes_plain_test(depth, ok)) {
+        wk->st.taylor_drops += (unsigned)(ok && plain_drop);
+        return plain_drop;
+    }
+    if (depth + 1 < wk->c->levels)
         return 0;
-    if (centred_form_excludes_zero(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], box, centre,
-                                   centre_fg(wk, s, centre)[0])) {
-        wk->st.taylor_drops++;
-        return 1;
+    wk->st.taylor_drops += retest & 1;
+    return retest != 0;
+}
+
+/* A leaf-parent waiting in a batch (leaf_batch): a single-surface scene's
+ * leaf-parents under one node are tested together, so that the lane
+ * evaluators get the candidate voxels of all of them at once. */
+typedef struct leaf_parent {
+    uint64_t cell[3];
+    unsigned slot; /* which child of its parent */
+    interval pbox[3], T[1][8];
+    double pc[3];
+    uint8_t ok[1], cand, cf8_have, centred[1], plain[1];
+    child_boxes cb;
+    double cf8[32];
+} leaf_parent;
+
+/* The children of the node (depth, cell) in slot order, with the node's
+ * forms (ok, T) and boxes (cb) made: their tests, then the voxels' records
+ * (retest: a leaf-parent, its re-tests in centred and plain), or the
+ * recursion. With batch, the children that would be recursed into are
+ * appended to it instead (*nb of them), their mask bits left to the caller. */
+static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3],
+                              const uint8_t *ok, interval T[][8], child_boxes *cb, int retest,
+                              const uint8_t *centred, const uint8_t *plain, leaf_parent *batch,
+                              unsigned *nb)
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf, pidx = depth + 1, cidx = depth + 2;
+    newton nw[8];
+    uint8_t child[8], surf[8], mask = 0, coarse[OCT_MAX_SURFACES];
+    unsigned np = 0;
+    children_plain_tests(wk, depth, ok, T, cb, coarse);
+    for (unsigned i = 0; i < 8 && !wk->failed; i++) {
+        const interval *box = cb->box[i];
+        const double *centre = cb->centre[i];
+        unsigned n = 0;
+        for (unsigned k = 0; k < wk->nact[pidx]; k++) {
+            unsigned s = wk->act[(size_t)pidx * ns + k];
+            const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+            if (ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) {
+                wk->st.taylor_drops++;
+                continue;
+            }
+            if (!child_box(cb, i))
+                break; /* outside the bounds */
+            if (retest && ok[k]) {
+                memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
+                wk->cf_ok[s] = 1;
+            }
+            unsigned rt = retest && ok[k] ? ((centred[k] >> i) & 1u) | ((plain[k] >> i) & 1u) << 1 : 0;
+            if (child_dropped(wk, depth, ok[k], (coarse[k] >> i) & 1, rt)) {
+                wk->cf_ok[s] = 0;
+                continue;
+            }
+            wk->act[(size_t)cidx * ns + n++] = (uint8_t)s;
+            wk->tapes[(size_t)cidx * ns + s] = *t;
+            wk->kinked[(size_t)cidx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
+        }
+        wk->nact[cidx] = n;
+        if (!n)
+            continue;
+        uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
+        if (retest) { /* records made below, all together */
+            child[np] = (uint8_t)i;
+            surf[np] = (uint8_t)(c->par->shell_only ? shell_surface(wk, cidx, centre) /* --shell-only */
+                                                    : voxel_surface(wk, cidx, centre, &nw[np]));
+            np++;
+            mask |= (uint8_t)(1u << i);
+        } else if (depth + 1 == c->levels) {
+            if (emit_voxel(wk, box, centre))
+                mask |= (uint8_t)(1u << i);
+        } else if (batch) {
+            leaf_parent *lp = &batch[(*nb)++];
+            memcpy(lp->cell, cc, sizeof cc);
+            lp->slot = i;
+        } else if (visit_node(wk, depth + 1, cc)) { /* the few children that go on */
+            mask |= (uint8_t)(1u << i);
+        }
     }
-    return wk->kinked[(size_t)pidx * ns + s] && !cell_may_cross(wk, t, s, depth + 1, box, centre);
+    if (np)
+        emit_voxels(wk, cb, child, surf, nw, np);
+    return wk->failed ? 0 : mask;
+}
+
+/* Appends a node's child mask as visit_node does. */
+static void push_mask(worker *wk, unsigned depth, uint8_t mask)
+{
+    if (mask && !wk->failed) {
+        if (buf_push(&wk->out->masks[depth], &mask, 1)) {
+            wk->failed = 1;
+            return;
+        }
+        wk->st.nodes++;
+    }
+}
+
+/* The leaf-parents (depth = levels - 1) of one node of a single-surface
+ * scene, each what visit_mean_value would make of it, with the evaluations
+ * pooled: f and its gradient at the candidate voxels' centres of all of
+ * them, in passes of TAPE_LANES points, then their re-tests likewise. The
+ * node's own form serves them all (their reuse). Returns the node's mask
+ * bits for them; their masks and voxels go out in slot order. */
+static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
+{
+    const build_ctx *c = wk->c;
+    const unsigned pidx = depth + 1;
+    const tape *t = &wk->tapes[pidx], *full = c->full[0];
+    interval *G = &wk->grad[pidx * 3];
+    memcpy(G, &wk->grad[depth * 3], 3 * sizeof *G);
+    wk->fcen[pidx] = wk->fcen[depth];
+    double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+    unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES], nit = 0;
+    retest_item it[64];
+    uint8_t it_lp[64], it_ch[64], drop[64];
+    for (unsigned b = 0; b < nb; b++) {
+        leaf_parent *p = &lp[b];
+        cell_box(c, depth, p->cell, p->pbox, p->pc);
+        p->ok[0] = (uint8_t)child_enclosures(wk, t, p->pbox, depth, p->cell, wk->ncen[depth],
+                                             &wk->fcen[pidx], G, 1, p->T[0]);
+        child_boxes_init(c, depth, p->cell, p->pbox, &p->cb);
+        p->cand = p->cf8_have = p->centred[0] = p->plain[0] = 0;
+        for (unsigned i = 0; i < 8 && p->ok[0]; i++)
+            if (!(p->T[0][i].lo > 0.0 || p->T[0][i].hi < 0.0) && child_box(&p->cb, i))
+                p->cand |= (uint8_t)(1u << i);
+        for (unsigned i = 0; i < 8; i++) { /* f and grad f at the candidates' centres */
+            if ((p->cand >> i) & 1) {
+                x[n] = p->cb.centre[i][0];
+                y[n] = p->cb.centre[i][1];
+                z[n] = p->cb.centre[i][2];
+                owner[n] = b;
+                ch[n++] = i;
+            }
+            if (n == TAPE_LANES || (n && b + 1 == nb && i == 7)) {
+                tape_eval_grad_lanes(full, n, x, y, z, f, g, wk->lslots);
+                wk->st.point_evals += n;
+                for (unsigned l = 0; l < n; l++) {
+                    leaf_parent *q = &lp[owner[l]];
+                    double *fg = q->cf8 + 4 * ch[l];
+                    fg[0] = f[l];
+                    fg[1] = g[0][l];
+                    fg[2] = g[1][l];
+                    fg[3] = g[2][l];
+                    q->cf8_have |= (uint8_t)(1u << ch[l]);
+                }
+                n = 0;
+            }
+        }
+    }
+    for (unsigned b = 0; b < nb; b++) /* the re-tests' candidates */
+        for (unsigned i = 0; i < 8; i++)
+            if ((lp[b].cand >> i) & 1) {
+                retest_item r = {lp[b].cb.box[i], lp[b].cb.centre[i], lp[b].cf8[4 * i]};
+                it_lp[nit] = (uint8_t)b;
+                it_ch[nit] = (uint8_t)i;
+                it[nit++] = r;
+            }
+    centred_form_drops(wk, t, G, it, nit, drop);
+    unsigned m = 0;
+    for (unsigned j = 0; j < nit; j++) {
+        if (drop[j]) {
+            lp[it_lp[j]].centred[0] |= (uint8_t)(1u << it_ch[j]);
+        } else {
+            it_lp[m] = it_lp[j];
+            it_ch[m] = it_ch[j];
+            it[m++] = it[j];
+        }
+    }
+    if (wk->kinked[pidx]) {
+        plain_test_drops(wk, t, 0, it, m, drop);
+        for (unsigned j = 0; j < m; j++)
+            if (drop[j])
+                lp[it_lp[j]].plain[0] |= (uint8_t)(1u << it_ch[j]);
+    }
+    double *cf8 = wk->cf8;
+    uint8_t mask = 0;
+    for (unsigned b = 0; b < nb && !wk->failed; b++) {
+        leaf_parent *p = &lp[b];
+        memcpy(wk->ncen[pidx], p->pc, sizeof p->pc);
+        wk->grad_ok[pidx] = p->ok[0];
+        wk->act[pidx] = 0;
+        wk->nact[pidx] = 1;
+        wk->cf8 = p->cf8;
+        wk->cf8_have[0] = wk->kinked[pidx] ? 0 : p->cf8_have;
+        uint8_t pm = visit_children(wk, depth, p->cell, p->ok, p->T, &p->cb, 1, p->centred,
+                                    p->plain, NULL, NULL);
+        wk->cf8 = cf8;
+        push_mask(wk, depth, pm);
+        if (pm)
+            mask |= (uint8_t)(1u << p->slot);
+    }
+    return wk->failed ? 0 : mask;
 }
 
 /* The finest levels: children are tested with child_enclosures, inheriting
@@ -90,10 +346,10 @@ static int child_dropped(worker *wk, unsigned depth, unsigned s, int ok, const i
 static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[3])
 {
     const build_ctx *c = wk->c;
-    const unsigned ns = c->nsurf, pidx = depth + 1, cidx = depth + 2;
+    const unsigned ns = c->nsurf, pidx = depth + 1;
     interval pbox[3], T[OCT_MAX_SURFACES][8];
     double pc[3];
-    uint8_t ok[OCT_MAX_SURFACES], mask = 0;
+    uint8_t ok[OCT_MAX_SURFACES];
     cell_box(c, depth, cell, pbox, pc);
     memcpy(wk->ncen[pidx], pc, sizeof pc);
     /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
@@ -115,57 +371,21 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     child_boxes cb; /* most children fall to T alone: boxes are made lazily */
     child_boxes_init(c, depth, cell, pbox, &cb);
     int retest = depth + 1 == c->levels && depth + 1 >= MEAN_VALUE_ALONE_DEPTH;
-    newton nw[8];
-    uint8_t child[8], surf[8];
-    unsigned np = 0;
-    if (retest)
+    uint8_t centred[OCT_MAX_SURFACES], plain[OCT_MAX_SURFACES];
+    if (retest) {
         leaf_centres(wk, depth, ok, T, &cb);
-    for (unsigned i = 0; i < 8 && !wk->failed; i++) {
-        const interval *box = cb.box[i];
-        const double *centre = cb.centre[i];
-        unsigned n = 0;
-        for (unsigned k = 0; k < wk->nact[pidx]; k++) {
-            unsigned s = wk->act[(size_t)pidx * ns + k];
-            const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-            if (ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) {
-                wk->st.taylor_drops++;
-                continue;
-            }
-            if (!child_box(&cb, i))
-                break; /* outside the bounds */
-            if (retest && ok[k]) {
-                memcpy(wk->cf + 4 * (size_t)s, wk->cf8 + ((size_t)s * 8 + i) * 4, 4 * sizeof *wk->cf);
-                wk->cf_ok[s] = 1;
-            }
-            if (child_dropped(wk, depth, s, ok[k], box, centre)) {
-                wk->cf_ok[s] = 0;
-                continue;
-            }
-            wk->act[(size_t)cidx * ns + n++] = (uint8_t)s;
-            wk->tapes[(size_t)cidx * ns + s] = *t;
-            wk->kinked[(size_t)cidx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
-        }
-        wk->nact[cidx] = n;
-        if (!n)
-            continue;
-        if (retest) { /* records made below, all together */
-            child[np] = (uint8_t)i;
-            surf[np] = (uint8_t)(c->par->shell_only ? shell_surface(wk, cidx, centre) /* --shell-only */
-                                                    : voxel_surface(wk, cidx, centre, &nw[np]));
-            np++;
-            mask |= (uint8_t)(1u << i);
-        } else if (depth + 1 == c->levels) {
-            if (emit_voxel(wk, box, centre))
-                mask |= (uint8_t)(1u << i);
-        } else { /* the child's coordinates, for the few children that go on */
-            uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1), 2 * cell[2] + (i >> 2)};
-            if (visit_node(wk, depth + 1, cc))
-                mask |= (uint8_t)(1u << i);
-        }
+        leaf_retests(wk, depth, ok, T, &cb, centred, plain);
     }
-    if (np)
-        emit_voxels(wk, &cb, child, surf, nw, np);
-    return wk->failed ? 0 : mask;
+    /* The parent of leaf-parents, one surface, its form there for them to
+     * reuse: they go to one batch. */
+    if (depth + 2 == c->levels && depth + 2 >= MEAN_VALUE_ALONE_DEPTH && ns == 1 &&
+        wk->nact[pidx] == 1 && ok[0]) {
+        leaf_parent batch[8];
+        unsigned nb = 0;
+        uint8_t mask = visit_children(wk, depth, cell, ok, T, &cb, 0, NULL, NULL, batch, &nb);
+        return nb && !wk->failed ? mask | leaf_batch(wk, depth + 1, batch, nb) : mask;
+    }
+    return visit_children(wk, depth, cell, ok, T, &cb, retest, centred, plain, NULL, NULL);
 }
 
 /* Builds the subtree of a cell already tested non-empty; returns its child
@@ -189,13 +409,7 @@ static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
                 mask |= (uint8_t)(1u << i);
         }
     }
-    if (mask) {
-        if (buf_push(&wk->out->masks[depth], &mask, 1)) {
-            wk->failed = 1;
-            return 0;
-        }
-        wk->st.nodes++;
-    }
+    push_mask(wk, depth, mask);
     return wk->failed ? 0 : mask;
 }
 

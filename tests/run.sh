@@ -26,6 +26,21 @@ for t in "$B"/tests/test_*; do
     echo "$name: $p passed, $f failed"
 done
 
+# The suites of the lane evaluators and the rasterizer again on the portable
+# build of the lane evaluators (DDA_SIMD=portable), so every dispatched path
+# is tested where the processor has AVX2.
+for name in test_tape_ilanes test_tape test_build; do
+    t="$B/tests/$name"
+    [ -x "$t" ] || continue
+    if DDA_SIMD=portable "$t" >"$log" 2>&1; then status=0; else status=$?; fi
+    p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | awk '{s+=$1} END {print s+0}')
+    f=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | awk '{s+=$1} END {print s+0}')
+    if [ "$status" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
+    passed=$((passed + p)); failed=$((failed + f))
+    if [ "$f" -ne 0 ]; then failures="$failures $name(portable)"; cat "$log"; fi
+    echo "$name (DDA_SIMD=portable): $p passed, $f failed"
+done
+
 for t in "$B"/tests/replay_*; do
     [ -x "$t" ] || continue
     name=$(basename "$t"); target=${name#replay_}

@@ -110,12 +110,45 @@ static void test_poles_without_a_finite_value(void **state)
     assert_true(v.lo == -INFINITY && v.hi == INFINITY);
 }
 
+/* The libm operations widen by two steps: with both ends normal numbers,
+ * exactly two nextafter steps outward (the fast path that makes them one
+ * step of 2), across the binades, both signs and up to DBL_MAX (tan of
+ * point intervals: its ends are tan(x) itself; powc near overflow). */
+static void test_two_steps_are_nextafter(void **state)
+{
+    (void)state;
+    static const double xs[] = {0.1, -0.1, 0.7853981633974483, -1.2, 1.5707963,
+                                -1.5707963, 1e-300, -1e-300, 3e-308, -3e-308};
+    for (size_t i = 0; i < sizeof xs / sizeof *xs; i++) {
+        unsigned f = 0;
+        double t = tan(xs[i]);
+        interval r = interval_tan(iv(xs[i], xs[i]), &f);
+        if (fabs(t) >= 0x1p-1020) /* the ends of two steps below stay normal */
+            assert_true(same(r, nextafter(nextafter(t, -INFINITY), -INFINITY),
+                             nextafter(nextafter(t, INFINITY), INFINITY)));
+        assert_true(r.lo < t && t < r.hi && f == 0);
+    }
+    for (double x = 1.0; x < 1e300; x *= 7.3) { /* pow(x, 1.5) up to overflow */
+        unsigned f = 0;
+        double p = pow(x, 1.5);
+        interval r = interval_powc(iv(x, x), 1.5, &f);
+        double lo = nextafter(nextafter(p, -INFINITY), -INFINITY);
+        double hi = p == INFINITY ? INFINITY : nextafter(nextafter(p, INFINITY), INFINITY);
+        if (!same(r, lo, hi))
+            fail_msg("powc(%a, 1.5) = [%a, %a], nextafter twice [%a, %a]", x, r.lo, r.hi, lo, hi);
+    }
+    unsigned f = 0;
+    interval r = interval_powc(iv(0x1.fffffffffffffp+681, 0x1.fffffffffffffp+681), 1.5, &f);
+    assert_true(r.hi == INFINITY || r.hi == DBL_MAX || r.hi > 0x1p1022); /* near DBL_MAX */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_infinite_ends_are_quiet),
         cmocka_unit_test(test_zero_divisor_has_no_value),
         cmocka_unit_test(test_poles_without_a_finite_value),
+        cmocka_unit_test(test_two_steps_are_nextafter),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -135,6 +135,30 @@ void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
  * enclosure of instruction i, for tape_prune. */
 interval tape_eval_interval(const tape *t, const interval box[3], interval *slots, unsigned *flags);
 
+/* tape_eval_interval on up to TAPE_LANES boxes at once: out[l] and flags[l]
+ * are, bit for bit, tape_eval_interval's result and flags on box[l], for
+ * l < n (1 <= n <= TAPE_LANES). The cheap operations run on all lanes in
+ * one pass (vector code), the libm ones lane by lane. `slots` is the
+ * caller's scratch of t->n elements (common/expr/tape_ilanes.c). */
+typedef struct tape_ilanes {
+    double lo[TAPE_LANES], hi[TAPE_LANES];
+} tape_ilanes;
+void tape_eval_interval_lanes(const tape *t, unsigned n, const interval box[][3], interval out[],
+                              unsigned flags[], tape_ilanes *slots);
+
+/* The builds of the lane evaluators a run may choose from: the portable one
+ * (the baseline instruction set) and, on x86-64 processors that have it,
+ * AVX2. tape_lanes_path is the one in use (AVX2 where available, unless a
+ * test build runs with DDA_SIMD=portable); tape_eval_interval_lanes_on runs
+ * a given one (an available one: tape_lanes_path_available), for tests. */
+enum { TAPE_PATH_PORTABLE = 0, TAPE_PATH_AVX2 = 1, TAPE_PATHS = 2 };
+int tape_lanes_path(void);
+int tape_lanes_path_available(int path);
+const char *tape_lanes_path_name(int path);
+void tape_eval_interval_lanes_on(int path, const tape *t, unsigned n,
+                                 const interval box[][3], interval out[],
+                                 unsigned flags[], tape_ilanes *slots);
+
 /* Enclosures of f and of each partial derivative over the box (forward-mode
  * AD in interval arithmetic): for every p in the box where f is defined and
  * differentiable, grad f(p) lies in grad[0..2] (unless *flags is set). */

@@ -5,56 +5,23 @@
  * instruction is paid once per pass and the lane loops are vector code. */
 #include "common/expr/tape.h"
 
-#include <math.h>
-#include <string.h>
+#include "common/expr/tape_ilanes_int.h"
 
-#include "common/expr/tape_int.h"
+#define NAME tape_grad_lanes_portable
+#include "common/expr/tape_lanes_inst.h"
+#undef NAME
 
-#define L TAPE_LANES
-
-/* Lanes from n on take lane 0's value (their points repeat lane 0's). */
-static void fill(double *v, unsigned n)
+/* The build for AVX2 (tape_lanes_avx2.c) where the processor has it
+ * (tape_lanes_path): the same operations, so the same bits. */
+void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
+                          const double y[TAPE_LANES], const double z[TAPE_LANES],
+                          double f[TAPE_LANES], double g[3][TAPE_LANES], tape_dual_lanes *s)
 {
-    for (unsigned l = n; l < L; l++)
-        v[l] = v[0];
-}
-
-#define W 2
-#define FN eval2
-#define SCALE scale2
-#include "common/expr/tape_lanes_body.h"
-#undef W
-#undef FN
-#undef SCALE
-#define W 4
-#define FN eval4
-#define SCALE scale4
-#include "common/expr/tape_lanes_body.h"
-#undef W
-#undef FN
-#undef SCALE
-#define W 6
-#define FN eval6
-#define SCALE scale6
-#include "common/expr/tape_lanes_body.h"
-#undef W
-#undef FN
-#undef SCALE
-#define W 8
-#define FN eval8
-#define SCALE scale8
-#include "common/expr/tape_lanes_body.h"
-
-/* The fewest lanes that hold n: the arithmetic runs on every lane. */
-void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[L], const double y[L],
-                          const double z[L], double f[L], double g[3][L], tape_dual_lanes *s)
-{
-    if (n <= 2)
-        eval2(t, n, x, y, z, f, g, s);
-    else if (n <= 4)
-        eval4(t, n, x, y, z, f, g, s);
-    else if (n <= 6)
-        eval6(t, n, x, y, z, f, g, s);
-    else
-        eval8(t, n, x, y, z, f, g, s);
+#if TAPE_ILANES_AVX2
+    if (tape_lanes_path() == TAPE_PATH_AVX2) {
+        tape_grad_lanes_avx2(t, n, x, y, z, f, g, s);
+        return;
+    }
+#endif
+    tape_grad_lanes_portable(t, n, x, y, z, f, g, s);
 }

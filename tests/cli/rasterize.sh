@@ -69,4 +69,15 @@ done
 "$BIN/rasterize" "$T/s2.scene" -o "$T/t1.oct" --levels 7 --threads 1 -q || fail "threads 1"
 "$BIN/rasterize" "$T/s2.scene" -o "$T/t2.oct" --levels 7 --threads 2 -q || fail "threads 2"
 cmp -s "$T/t1.oct" "$T/t2.oct" || fail "thread count changed the output"
+
+# ... and whatever build of the lane evaluators runs (AVX2 where the
+# processor has it, or the portable one): levels 8, where the voxels'
+# re-tests run on lanes, on scenes with and without kinks and several
+# surfaces.
+for sc in blobs_a csg gyroid_ball multi heart; do
+    "$BIN/rasterize" "$ROOT/scenes/$sc.scene" -o "$T/d.oct" --levels 8 -q || fail "$sc: default path"
+    DDA_SIMD=portable "$BIN/rasterize" "$ROOT/scenes/$sc.scene" -o "$T/p.oct" --levels 8 -q \
+        || fail "$sc: portable path"
+    cmp -s "$T/d.oct" "$T/p.oct" || fail "$sc: the lane evaluators' build changed the output"
+done
 pass

@@ -1,0 +1,84 @@
+/* interval_lanes: the fast path of interval_add and interval_mul in a form
+ * that vectorises: bit-pattern tests (no floating-point exception, no
+ * branch) of when that path applies, and its bit steps. Where il_normal
+ * holds for a sum's ends, interval_add's result is [il_step_down(lo),
+ * il_step_up(hi)]; where the four ends of two factors are finite and the
+ * least and greatest of the four products are normal, interval_mul's is the
+ * same of those. Used by the lane interval evaluator (tape_ilanes.c) and the
+ * rasterizer's mean-value forms. */
+#ifndef INTERVAL_LANES_H
+#define INTERVAL_LANES_H
+
+#include <stdint.h>
+#include <string.h>
+
+static inline uint64_t il_bits(double x)
+{
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    return u;
+}
+static inline double il_double(uint64_t u)
+{
+    double x;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+/* 1 when x is neither infinite nor NaN, else 0 (a quiet test). */
+static inline uint64_t il_finite(double x) { return ((il_bits(x) >> 52) & 0x7ff) != 0x7ff; }
+/* 1 when x is finite and |x| >= DBL_MIN (not 0, not subnormal), else 0. */
+static inline uint64_t il_normal(double x) { return ((il_bits(x) >> 52) & 0x7ff) - 1 < 0x7fe; }
+/* interval__up_finite and interval__down_finite of such a normal x: the
+ * bit step alone. */
+static inline double il_step_up(double x)
+{
+    uint64_t u = il_bits(x);
+    return il_double(u + (1 - ((u >> 63) << 1)));
+}
+static inline double il_step_down(double x)
+{
+    uint64_t u = il_bits(x);
+    return il_double(u - (1 - ((u >> 63) << 1)));
+}
+/* m ? a : b for m 0 or 1, on the bit patterns (vector code without
+ * branches). */
+static inline double il_sel(uint64_t m, double a, double b)
+{
+    return il_double((il_bits(a) & (0 - m)) | (il_bits(b) & (m - 1)));
+}
+static inline double il_min(double a, double b) { return a < b ? a : b; } /* as interval__min2 */
+static inline double il_max(double a, double b) { return a > b ? a : b; }
+
+
+#include "common/expr/interval.h"
+
+/* interval_add(a, b) where its fast path applies; *ok becomes 0 where it
+ * does not (the result is then not interval_add's). */
+static inline interval il_add(interval a, interval b, uint64_t *ok)
+{
+    double lo = a.lo + b.lo, hi = a.hi + b.hi;
+    *ok &= il_normal(lo) & il_normal(hi);
+    interval r = {il_step_down(lo), il_step_up(hi)};
+    return r;
+}
+
+/* 1 when x is +0 or -0. */
+static inline uint64_t il_zero(double x) { return (il_bits(x) << 1) == 0; }
+
+/* interval_mul(a, b) likewise; with finite ends, a factor that is exactly
+ * [0, 0] gives interval_mul's [+0, +0] (a zero end from a zero factor stays
+ * 0: the partials of a term without that variable). */
+static inline interval il_mul(interval a, interval b, uint64_t *ok)
+{
+    uint64_t f = il_finite(a.lo) & il_finite(a.hi) & il_finite(b.lo) & il_finite(b.hi);
+    uint64_t z = (il_zero(a.lo) & il_zero(a.hi)) | (il_zero(b.lo) & il_zero(b.hi));
+    double al = il_sel(f, a.lo, 1.0), ah = il_sel(f, a.hi, 1.0);
+    double bl = il_sel(f, b.lo, 1.0), bh = il_sel(f, b.hi, 1.0);
+    double p1 = al * bl, p2 = al * bh, p3 = ah * bl, p4 = ah * bh;
+    double lo = il_min(il_min(p1, p2), il_min(p3, p4)), hi = il_max(il_max(p1, p2), il_max(p3, p4));
+    *ok &= f & (z | (il_normal(lo) & il_normal(hi)));
+    interval r = {il_sel(z, 0.0, il_step_down(lo)), il_sel(z, 0.0, il_step_up(hi))};
+    return r;
+}
+
+#endif

@@ -1,0 +1,65 @@
+/* tape_ilanes_int.h: what the two builds of the lane evaluators (interval:
+ * tape_ilanes.c, gradient: tape_lanes.c) share (private to common/expr/): bit-pattern tests and steps that
+ * vectorise, and the entry each build defines. */
+#ifndef TAPE_ILANES_INT_H
+#define TAPE_ILANES_INT_H
+
+#include <stdint.h>
+#include <string.h>
+
+#include "common/expr/interval_lanes.h"
+#include "common/expr/tape.h"
+
+#define IL_CAT2(a, b) a##b
+#define CAT(a, b) IL_CAT2(a, b)
+
+/* The AVX2 build exists on x86-64 with a GCC-compatible compiler. */
+#if defined(__x86_64__) && defined(__GNUC__)
+#define TAPE_ILANES_AVX2 1
+#else
+#define TAPE_ILANES_AVX2 0
+#endif
+
+static inline interval il_get(const tape_ilanes *v, unsigned l)
+{
+    interval r = {v->lo[l], v->hi[l]};
+    return r;
+}
+static inline void il_set(tape_ilanes *v, unsigned l, interval x)
+{
+    v->lo[l] = x.lo;
+    v->hi[l] = x.hi;
+}
+
+/* One build's evaluator: tape_eval_interval_lanes with the boxes already in
+ * lanes (lanes n.. repeating lane 0) and fl[] cleared. */
+void tape_ilanes_portable(const tape *t, unsigned n, const tape_ilanes box[3],
+                          unsigned fl[TAPE_LANES], tape_ilanes *slots);
+#if TAPE_ILANES_AVX2
+void tape_ilanes_avx2(const tape *t, unsigned n, const tape_ilanes box[3],
+                      unsigned fl[TAPE_LANES], tape_ilanes *slots);
+#endif
+
+/* The lane gradient evaluator's builds (tape_lanes.c, tape_lanes_avx2.c):
+ * tape_eval_grad_lanes on one of them. */
+void tape_grad_lanes_portable(const tape *t, unsigned n, const double x[TAPE_LANES],
+                              const double y[TAPE_LANES], const double z[TAPE_LANES],
+                              double f[TAPE_LANES], double g[3][TAPE_LANES], tape_dual_lanes *s);
+#if TAPE_ILANES_AVX2
+void tape_grad_lanes_avx2(const tape *t, unsigned n, const double x[TAPE_LANES],
+                          const double y[TAPE_LANES], const double z[TAPE_LANES],
+                          double f[TAPE_LANES], double g[3][TAPE_LANES], tape_dual_lanes *s);
+#endif
+
+/* The definitions of one build (NAME its entry), from tape_ilanes_body.h. */
+#define TAPE_ILANES_DEFINE(NAME)                                                              \
+    void NAME(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[TAPE_LANES],    \
+              tape_ilanes *slots)                                                             \
+    {                                                                                         \
+        if (n <= 4)                                                                           \
+            CAT(NAME, _4)(t, n, box, fl, slots);                                              \
+        else                                                                                  \
+            CAT(NAME, _8)(t, n, box, fl, slots);                                              \
+    }
+
+#endif

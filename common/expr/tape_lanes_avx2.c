@@ -1,0 +1,14 @@
+/* tape_lanes_avx2: the lane gradient evaluator (tape_lanes.c) compiled for
+ * AVX2 (this file alone gets -mavx2; no FMA, and -ffp-contract=off as
+ * everywhere, so every lane rounds as the portable build does). */
+#include "common/expr/tape_ilanes_int.h"
+
+#if TAPE_ILANES_AVX2
+#if !defined(__AVX2__) || defined(__FMA__)
+#error "tape_lanes_avx2.c is compiled with -mavx2 (and without -mfma)"
+#endif
+#define NAME tape_grad_lanes_avx2
+#include "common/expr/tape_lanes_inst.h"
+#else
+typedef int tape_lanes_avx2_unused; /* not an empty file */
+#endif

@@ -1,0 +1,159 @@
+/* Tests for the lane interval evaluator (common/expr/tape_ilanes.c): on
+ * every build the processor can run (portable, AVX2), each lane gives the
+ * bits and flags of tape_eval_interval on its box, for random trees of every
+ * operation over boxes that reach the edge cases (points, signed zeros,
+ * subnormal and huge ends, infinite ends, overflow), and for the example
+ * scenes over the cells of their subdivision. Runs from the repository
+ * root (reads scenes/). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "common/expr/scene.h"
+#include "common/expr/tape.h"
+#include "tests/test_tape_util.h"
+
+static int same_bits(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b));
+}
+
+static tape_ilanes lslots[MAXSLOTS];
+static interval islots[MAXSLOTS];
+
+/* Lane by lane against tape_eval_interval, on the given path. */
+static void check(int path, const tape *t, const interval box[][3], unsigned n, const char *what)
+{
+    interval out[TAPE_LANES];
+    unsigned fl[TAPE_LANES];
+    tape_eval_interval_lanes_on(path, t, n, box, out, fl, lslots);
+    for (unsigned l = 0; l < n; l++) {
+        unsigned f1;
+        interval r = tape_eval_interval(t, box[l], islots, &f1);
+        if (!same_bits(out[l].lo, r.lo) || !same_bits(out[l].hi, r.hi) || fl[l] != f1)
+            fail_msg("%s path %s lane %u of %u, box [%a,%a]x[%a,%a]x[%a,%a]: [%a,%a] flags %u, "
+                     "scalar [%a,%a] flags %u",
+                     what, tape_lanes_path_name(path), l, n, box[l][0].lo, box[l][0].hi,
+                     box[l][1].lo, box[l][1].hi, box[l][2].lo, box[l][2].hi, out[l].lo,
+                     out[l].hi, fl[l], r.lo, r.hi, f1);
+    }
+}
+
+/* An end from the edge cases, or an ordinary number. */
+static double edge_value(void)
+{
+    static const double v[] = {0.0, -0.0, DBL_MIN, -DBL_MIN, 0x1p-1070, -0x1p-1070, 1e300,
+                               -1e300, 1e-300, INFINITY, -INFINITY, 1.0, -1.0, 0.78, 3.0};
+    return v[next_u64() % (sizeof v / sizeof v[0])];
+}
+
+static void rand_box(interval box[3])
+{
+    rand_tree_box(box);
+    for (int a = 0; a < 3; a++) {
+        uint64_t r = next_u64() % 16;
+        if (r == 0) { /* an edge value as a point */
+            box[a].lo = box[a].hi = edge_value();
+        } else if (r == 1) { /* an edge value at either end */
+            double e = edge_value(), c = box[a].lo;
+            box[a].lo = e < c ? e : c;
+            box[a].hi = e < c ? c : e;
+        }
+    }
+}
+
+static void test_random_trees(void **state)
+{
+    (void)state;
+    static char text[16384];
+    interval box[TAPE_LANES][3];
+    for (int n = 0; n < 4000 / SCALE; n++) {
+        scene *s = rand_tree(text, sizeof text);
+        const tape *t = &s->surfaces[0].tape;
+        assert_true(t->n <= MAXSLOTS);
+        unsigned lanes = 1 + (unsigned)n % TAPE_LANES;
+        for (unsigned l = 0; l < lanes; l++)
+            rand_box(box[l]);
+        for (int path = 0; path < TAPE_PATHS; path++)
+            if (tape_lanes_path_available(path))
+                check(path, t, (const interval(*)[3])box, lanes, text);
+        scene_free(s);
+    }
+}
+
+/* The example scenes over random cells of their subdivision (levels 1 to
+ * 12) and the points at those cells' centres, as the rasterizer asks. */
+static void test_scenes(void **state)
+{
+    (void)state;
+    FILE *ls = popen("ls scenes/*.scene", "r");
+    assert_non_null(ls);
+    char path[512];
+    int nscenes = 0;
+    while (fgets(path, sizeof path, ls)) {
+        path[strcspn(path, "\n")] = 0;
+        scene *s = NULL;
+        scene_error e;
+        if (scene_load(path, &s, &e) != 0)
+            fail_msg("%s:%u:%u: %s", path, e.line, e.col, e.message);
+        nscenes++;
+        for (size_t j = 0; j < s->nsurfaces; j++) {
+            const tape *t = &s->surfaces[j].tape;
+            assert_true(t->n <= MAXSLOTS);
+            for (int i = 0; i < 400 / SCALE; i++) {
+                interval box[TAPE_LANES][3];
+                unsigned lanes = 1 + (unsigned)i % TAPE_LANES, level = 1 + (unsigned)i % 12;
+                for (unsigned l = 0; l < lanes; l++)
+                    for (int a = 0; a < 3; a++) {
+                        double h = ldexp(s->hi[a] - s->lo[a], -(int)level);
+                        double lo = s->lo[a] + floor(unit() * ldexp(1.0, (int)level)) * h;
+                        box[l][a].lo = lo;
+                        box[l][a].hi = i & 1 ? lo + h : lo + 0.5 * h; /* odd: cells, even: points */
+                        if (!(i & 1))
+                            box[l][a].lo = box[l][a].hi;
+                    }
+                for (int p = 0; p < TAPE_PATHS; p++)
+                    if (tape_lanes_path_available(p))
+                        check(p, t, (const interval(*)[3])box, lanes, path);
+            }
+        }
+        scene_free(s);
+    }
+    pclose(ls);
+    assert_true(nscenes >= 10);
+}
+
+/* The path in use is one that is available; DDA_SIMD=portable (test
+ * builds) selects the portable one. */
+static void test_path_choice(void **state)
+{
+    (void)state;
+    int p = tape_lanes_path();
+    assert_true(tape_lanes_path_available(p));
+    assert_true(tape_lanes_path_available(TAPE_PATH_PORTABLE));
+    const char *v = getenv("DDA_SIMD");
+    if (v && strcmp(v, "portable") == 0)
+        assert_int_equal(p, TAPE_PATH_PORTABLE);
+    else
+        assert_int_equal(p, tape_lanes_path_available(TAPE_PATH_AVX2) ? TAPE_PATH_AVX2
+                                                                       : TAPE_PATH_PORTABLE);
+    printf("lane evaluator path: %s\n", tape_lanes_path_name(p));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_random_trees),
+        cmocka_unit_test(test_scenes),
+        cmocka_unit_test(test_path_choice),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
