@@ -2,8 +2,24 @@
 #include "render/ao.h"
 
 #include <math.h>
+#include <pthread.h>
 
 #include "render/shadow.h"
+
+/* cos and sin of 2 pi frac(k phi), k < AO_MAX_RAYS: the pattern's azimuths,
+ * made once; a hit turns them by its pixel's angle (ao_basis). */
+static double azimuth[AO_MAX_RAYS][2];
+static pthread_once_t azimuth_once = PTHREAD_ONCE_INIT;
+
+static void azimuth_init(void)
+{
+    for (unsigned k = 0; k < AO_MAX_RAYS; k++) {
+        double turns = (double)k * 0.61803398874989484820;
+        turns -= floor(turns);
+        azimuth[k][0] = cos(2.0 * M_PI * turns);
+        azimuth[k][1] = sin(2.0 * M_PI * turns);
+    }
+}
 
 uint32_t ao_seed(uint32_t i, uint32_t j)
 {
@@ -13,8 +29,12 @@ uint32_t ao_seed(uint32_t i, uint32_t j)
     return (uint32_t)((x ^ (x >> 31)) >> 32);
 }
 
-void ao_basis(const float n[3], ao_frame *f)
+void ao_basis(const float n[3], uint32_t seed, ao_frame *f)
 {
+    pthread_once(&azimuth_once, azimuth_init);
+    const double turn = 2.0 * M_PI * ((double)seed * 0x1p-32);
+    f->cs = cos(turn);
+    f->ss = sin(turn);
     double *nn = f->n;
     for (int a = 0; a < 3; a++)
         nn[a] = n[a];
@@ -32,14 +52,12 @@ void ao_basis(const float n[3], ao_frame *f)
     f->b[2] = -nn[1];
 }
 
-void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, uint32_t seed, double d[3])
+void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, double d[3])
 {
     const double u = ((double)k + 0.5) / (double)m;
-    double turns = (double)k * 0.61803398874989484820 + (double)seed * 0x1p-32;
-    turns -= floor(turns);
-    const double phi = 2.0 * M_PI * turns;
     const double r = sqrt(u), c = sqrt(1.0 - u);
-    const double x = r * cos(phi), y = r * sin(phi);
+    const double ca = azimuth[k][0], sa = azimuth[k][1]; /* turned by the pixel's angle */
+    const double x = r * (ca * f->cs - sa * f->ss), y = r * (sa * f->cs + ca * f->ss);
     for (int a = 0; a < 3; a++)
         d[a] = x * f->t[a] + y * f->b[a] + c * f->n[a];
 }
@@ -47,8 +65,8 @@ void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, uint32_t seed, d
 void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3])
 {
     ao_frame f;
-    ao_basis(n, &f);
-    ao_direction_in(&f, k, m, seed, d);
+    ao_basis(n, seed, &f);
+    ao_direction_in(&f, k, m, d);
 }
 
 /* The unoccluded fraction of the rays k0 .. k0 + count - 1 from the grid
@@ -61,11 +79,11 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
     if (!traverse)
         traverse = trace_impls[0].traverse;
     ao_frame f;
-    ao_basis(n, &f);
+    ao_basis(n, seed, &f);
     unsigned open = 0;
     for (unsigned k = k0; k < k0 + count; k++) {
         double d[3];
-        ao_direction_in(&f, k, m, seed, d);
+        ao_direction_in(&f, k, m, d);
         trace_ray r;
         if (!trace_setup_eye(e, d, &r) || !trace_clip(&r, 0.0, dist)) {
             open++;

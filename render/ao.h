@@ -4,9 +4,10 @@
  * by the fraction that meet nothing (RENDER.md, "Ambient occlusion").
  *
  * Directions: ray k of M is u_k = (k + 1/2) / M (stratified in cos^2 of the
- * angle to the normal: cosine weighting), azimuth 2 pi frac(k phi + s) with
- * phi the golden ratio's fraction and s a hash of the pixel: a fixed
- * pattern a pixel, rotated from pixel to pixel, the same whatever thread
+ * angle to the normal: cosine weighting), azimuth 2 pi frac(k phi) + 2 pi s
+ * with phi the golden ratio's fraction and s = seed / 2^32 from a hash of
+ * the pixel: a fixed pattern (its azimuths' cos and sin made once), turned
+ * from pixel to pixel (one cos and sin a hit), the same whatever thread
  * traces it. cos = sqrt(1 - u_k) >= sqrt(1 / (2M)) > 0: every ray leaves
  * the surface's side, so a plane alone occludes none (factor 1 exactly). */
 #ifndef AO_H
@@ -28,14 +29,15 @@ uint32_t ao_seed(uint32_t i, uint32_t j);
  * `seed`, in d[3] (unit). */
 void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, double d[3]);
 
-/* ao_direction in two parts: the hemisphere's frame for n once
- * (ao_basis), then each ray in it (ao_direction_in): the same operations
- * on the same values, so the same bits. */
+/* ao_direction in two parts: the hemisphere's frame for n and the pixel's
+ * turn by `seed` once (ao_basis), then each ray in it (ao_direction_in):
+ * the same operations on the same values, so the same bits. */
 typedef struct ao_frame {
     double t[3], b[3], n[3];
+    double cs, ss; /* cos and sin of the pixel's turn */
 } ao_frame;
-void ao_basis(const float n[3], ao_frame *f);
-void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, uint32_t seed, double d[3]);
+void ao_basis(const float n[3], uint32_t seed, ao_frame *f);
+void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, double d[3]);
 
 /* The unoccluded fraction of rays k0 .. k0 + count - 1 of M from the world
  * point o (shadow_origin's) over unit n: (rays meeting nothing) / count,

@@ -34,8 +34,8 @@ static void test_directions(void **state)
                 ao_direction(ns[k], r, m, ao_seed(3, 7), e);
                 assert_memory_equal(d, e, sizeof d);
                 ao_frame f; /* the frame once, the rays in it: the same bits */
-                ao_basis(ns[k], &f);
-                ao_direction_in(&f, r, m, ao_seed(3, 7), e);
+                ao_basis(ns[k], ao_seed(3, 7), &f);
+                ao_direction_in(&f, r, m, e);
                 assert_memory_equal(d, e, sizeof d);
                 const double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
                 assert_true(fabs(len - 1.0) < 1e-12);
