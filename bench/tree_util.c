@@ -1,6 +1,8 @@
 /* tree_util: in-memory oct_tree builder for tests and benchmarks. */
 #include "bench/tree_util.h"
 
+#include "bench/rng.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -138,4 +140,21 @@ oct_tree *tree_util_simple(unsigned levels, const uint32_t (*xyz)[3], size_t n)
 {
     static const double origin[3] = {0, 0, 0};
     return tree_util_build(levels, origin, 1.0, xyz, n, NULL, NULL, 1, NULL);
+}
+
+size_t tree_util_distinct_voxels(size_t n, uint32_t lo, uint32_t width, uint64_t *rng_state,
+                                 uint32_t (*xyz)[3])
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t v[3];
+        for (int a = 0; a < 3; a++)
+            v[a] = lo + (uint32_t)(rng_xorshift64star(rng_state) % width);
+        int dup = 0;
+        for (size_t j = 0; j < m && !dup; j++)
+            dup = !memcmp(xyz[j], v, sizeof v);
+        if (!dup)
+            memcpy(xyz[m++], v, sizeof v);
+    }
+    return m;
 }

@@ -24,6 +24,12 @@ oct_tree *tree_util_simple(unsigned levels, const uint32_t (*xyz)[3], size_t n);
 
 void tree_util_free(oct_tree *t); /* accepts NULL */
 
+/* Up to n distinct voxels drawn from [lo, lo + width)^3 into xyz, each
+ * coordinate rng_xorshift64star(rng_state) % width (bench/rng.h); a repeat
+ * is dropped. Returns how many were kept. */
+size_t tree_util_distinct_voxels(size_t n, uint32_t lo, uint32_t width, uint64_t *rng_state,
+                                 uint32_t (*xyz)[3]);
+
 /* Morton code of (x, y, z): bit i of x goes to bit 3i (x + 2y + 4z order). */
 uint64_t tree_util_morton(uint32_t x, uint32_t y, uint32_t z);
 

@@ -382,22 +382,6 @@ static void test_tree_util_layout(void **state)
     tree_util_free(t);
 }
 
-/* Up to n distinct voxels drawn from [lo, lo + width)^3 into xyz; returns
- * how many. */
-static size_t distinct_voxels(size_t n, uint32_t lo, uint32_t width, uint32_t (*xyz)[3])
-{
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++) {
-        const uint32_t v[3] = {lo + irand(width), lo + irand(width), lo + irand(width)};
-        int dup = 0;
-        for (size_t j = 0; j < m && !dup; j++)
-            dup = !memcmp(xyz[j], v, sizeof v);
-        if (!dup)
-            memcpy(xyz[m++], v, sizeof v);
-    }
-    return m;
-}
-
 /* trace_clip: a ray started at any plane time before its hit (or at the
  * hit's own entry time) meets the same voxel at the same t, bits and all, as
  * the whole ray: rays full of exact ties (dyadic eyes, direction components
@@ -414,7 +398,7 @@ static void test_clip_same_hit(void **state)
         uint32_t *attr = malloc(n * sizeof *attr);
         assert_non_null(xyz);
         assert_non_null(attr);
-        const size_t m = distinct_voxels(n, 0, N, xyz);
+        const size_t m = tree_util_distinct_voxels(n, 0, N, &rng_state, xyz);
         for (size_t i = 0; i < m; i++) {
             const double nr[3] = {(double)irand(5) - 2.0, (double)irand(5) - 2.0, 1.0};
             attr[i] = oct_voxel_pack(nr, ((double)irand(200) - 100.0) / 128.0);
@@ -496,7 +480,8 @@ static void test_anchored_same_hit(void **state)
         assert_non_null(attr);
         /* clustered off the root's mid-planes, so that occupied cells nest
          * deeply */
-        const size_t m = distinct_voxels(n, N / 8 + irand(N / 2 + 1), N / 4 + 1, xyz);
+        const uint32_t base = N / 8 + irand(N / 2 + 1);
+        const size_t m = tree_util_distinct_voxels(n, base, N / 4 + 1, &rng_state, xyz);
         for (size_t i = 0; i < m; i++)
             attr[i] = (uint32_t)i + 1;
         const double origin[3] = {0, 0, 0};

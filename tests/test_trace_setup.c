@@ -22,22 +22,6 @@ static uint64_t rng(void) { return rng_xorshift64star(&rng_state); }
 static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
 
-/* n random voxels in [lo, lo + width)^3, duplicates dropped; returns how
- * many are left. */
-static size_t random_voxels(size_t n, uint32_t lo, uint32_t width, uint32_t (*xyz)[3])
-{
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++) {
-        const uint32_t v[3] = {lo + irand(width), lo + irand(width), lo + irand(width)};
-        int dup = 0;
-        for (size_t j = 0; j < m && !dup; j++)
-            dup = !memcmp(xyz[j], v, sizeof v);
-        if (!dup)
-            memcpy(xyz[m++], v, sizeof v);
-    }
-    return m;
-}
-
 /* trace_setup_eye's shortcut for eyes inside the root cube gives the ray
  * of the general path, bit for bit: eyes anywhere inside, on faces, edges
  * and corners, directions with zero, tiny and huge components. */
@@ -143,7 +127,8 @@ static void test_anchor_find_reference(void **state)
         const size_t n = 1 + irand(N < 64 ? N * N + 1 : 4000);
         uint32_t(*xyz)[3] = malloc(n * sizeof *xyz);
         assert_non_null(xyz);
-        const size_t m = random_voxels(n, N / 8, N - N / 8 > 0 ? N - N / 8 : 1, xyz);
+        const uint32_t width = N - N / 8 > 0 ? N - N / 8 : 1;
+        const size_t m = tree_util_distinct_voxels(n, N / 8, width, &rng_state, xyz);
         oct_tree *t = tree_util_simple(L, (const uint32_t(*)[3])xyz, m);
         assert_non_null(t);
         trace_anchor last;
