@@ -17,6 +17,7 @@
 #include "format/oct.h"
 #include "format/oct_normal.h"
 #include "rasterize/build.h"
+#include "tests/scene_util.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SANITIZED 1
@@ -84,21 +85,12 @@ static int64_t find_voxel(const oct_tree *t, uint64_t x, uint64_t y, uint64_t z)
     return (int64_t)node;
 }
 
-static scene *load(const char *path)
-{
-    scene *sc = NULL;
-    scene_error err;
-    if (scene_load(path, &sc, &err) != 0)
-        fail_msg("%s:%u:%u: %s", path, err.line, err.col, err.message);
-    return sc;
-}
-
 /* Every voxel whose (k+1)^3 sample lattice (corners included) holds a sign
  * change of any surface, or an exact zero, must be in the tree. Samples
  * outside the scene's bounds do not count: the surface lives in them. */
 static void check_no_voxel_lost(const char *path, unsigned levels, unsigned k, build_method method)
 {
-    scene *sc = load(path);
+    scene *sc = test_scene_load(path);
     built b;
     build_in_memory(sc, levels, method, 2, &b);
     double origin[3], edge;
@@ -204,7 +196,7 @@ static void test_output_independent_of_threads(void **state)
     static const struct { const char *path; unsigned levels, san_levels; } cases[] = {
         {"scenes/blobs_b.scene", 7, 5}, {"scenes/blobs_b.scene", 8, 8}, {"scenes/csg.scene", 8, 8}};
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
-        scene *sc = load(cases[k].path);
+        scene *sc = test_scene_load(cases[k].path);
         built one, two;
         unsigned levels = SANITIZED ? cases[k].san_levels : cases[k].levels;
         build_in_memory(sc, levels, BUILD_INTERVAL, 1, &one);
@@ -226,7 +218,7 @@ static void test_shell_only_same_voxels(void **state)
     static const char *paths[] = {"scenes/blobs_b.scene", "scenes/multi.scene", "scenes/csg.scene"};
     for (size_t k = 0; k < sizeof paths / sizeof *paths; k++)
         for (unsigned levels = 6; levels <= (SANITIZED ? 6u : 8u); levels += 2) {
-            scene *sc = load(paths[k]);
+            scene *sc = test_scene_load(paths[k]);
             build_params full = {.levels = levels, .method = BUILD_INTERVAL, .threads = 2};
             build_params shell = full;
             shell.shell_only = 1;
@@ -348,7 +340,7 @@ static int exact_record(const tape *t, tape_dual *slots, const double c[3], doub
 static void test_normals_from_whole_function(void **state)
 {
     (void)state;
-    scene *sc = load("scenes/blobs_b.scene");
+    scene *sc = test_scene_load("scenes/blobs_b.scene");
     const unsigned levels = 8;
     built b;
     build_in_memory(sc, levels, BUILD_INTERVAL, 2, &b);

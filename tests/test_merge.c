@@ -21,6 +21,7 @@
 #include "format/oct_merge.h"
 #include "rasterize/build.h"
 #include "rasterize/shard.h"
+#include "tests/scene_util.h"
 
 static char dir[] = "/tmp/test_merge.XXXXXX";
 static int with_function; /* files store the surfaces' tapes (format 1.1), as rasterize's do */
@@ -37,15 +38,6 @@ static int teardown(void **state)
     char cmd[64];
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     return system(cmd) == 0 ? 0 : -1;
-}
-
-static scene *load(const char *path)
-{
-    scene *sc = NULL;
-    scene_error err;
-    if (scene_load(path, &sc, &err) != 0)
-        fail_msg("%s:%u:%u: %s", path, err.line, err.col, err.message);
-    return sc;
 }
 
 /* Rasterizes shard index/count (count 0: the whole grid) into path. */
@@ -149,7 +141,7 @@ static void split_free(split *s)
 /* Merged in order, reversed and shuffled: always the whole file. */
 static void check_merge(const char *scene_path, unsigned levels, uint32_t n)
 {
-    scene *sc = load(scene_path);
+    scene *sc = test_scene_load(scene_path);
     char whole[256], out[256];
     snprintf(whole, sizeof whole, "%s/whole.oct", dir);
     snprintf(out, sizeof out, "%s/merged.oct", dir);
@@ -248,7 +240,7 @@ static void test_merge_refuses(void **state)
 {
     (void)state;
     with_function = 1;
-    scene *a = load("scenes/blobs_a.scene"), *b = load("scenes/blobs_b.scene");
+    scene *a = test_scene_load("scenes/blobs_a.scene"), *b = test_scene_load("scenes/blobs_b.scene");
     split s3, s2, t3, l3;
     make_split(a, 7, 3, "a", &s3);
     make_split(a, 7, 2, "a", &s2);

@@ -16,6 +16,7 @@
 #include "format/oct.h"
 #include "rasterize/build.h"
 #include "rasterize/shard.h"
+#include "tests/scene_util.h"
 
 static void test_parse(void **state)
 {
@@ -159,21 +160,12 @@ static void build_part(const scene *sc, unsigned levels, unsigned threads, uint3
     free(bytes);
 }
 
-static scene *load(const char *path)
-{
-    scene *sc = NULL;
-    scene_error err;
-    if (scene_load(path, &sc, &err) != 0)
-        fail_msg("%s:%u:%u: %s", path, err.line, err.col, err.message);
-    return sc;
-}
-
 /* The shards of an N-way split, in shard order, are the whole tree's
  * voxels cut into consecutive runs, each inside its range, with the same
  * records and surfaces, and every shard computes the same partition. */
 static void check_union(const char *path, unsigned levels, uint32_t count, unsigned threads)
 {
-    scene *sc = load(path);
+    scene *sc = test_scene_load(path);
     voxels whole;
     build_part(sc, levels, 2, 0, 0, &whole, NULL);
     uint64_t at = 0, next_lo = 0;

@@ -18,6 +18,7 @@
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
 #include "tests/test_tape_util.h"
+#include "tests/scene_util.h"
 
 /* ---- the scenes in plain C ---------------------------------------------- */
 
@@ -174,10 +175,7 @@ static const struct {
 
 static scene *load(const char *path)
 {
-    scene *s = NULL;
-    scene_error e;
-    if (scene_load(path, &s, &e) != 0)
-        fail_msg("%s:%u:%u: %s", path, e.line, e.col, e.message);
+    scene *s = test_scene_load(path);
     assert_true(s->nsurfaces >= 1);
     for (size_t i = 0; i < s->nsurfaces; i++)
         assert_true(s->surfaces[i].tape.n <= MAXSLOTS);
