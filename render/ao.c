@@ -76,8 +76,6 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
                            unsigned k0, unsigned count, unsigned m, uint32_t seed, uint64_t *steps)
 {
     const double dist = AO_DISTANCE * tree->edge;
-    if (!traverse)
-        traverse = trace_impls[0].traverse;
     ao_frame f;
     ao_basis(n, seed, &f);
     unsigned open = 0;
@@ -89,10 +87,7 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
             open++;
             continue;
         }
-        trace_hit h;
-        traverse(tree, opts, &r, an, &h);
-        *steps += h.steps;
-        open += !h.hit;
+        open += !shadow_cast(tree, opts, traverse, &r, an, steps);
     }
     return (float)open / (float)count;
 }

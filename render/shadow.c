@@ -100,6 +100,23 @@ int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], 
     return ok;
 }
 
+int shadow_cast(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                const trace_ray *r, const trace_anchor *an, uint64_t *steps)
+{
+    if (!opts->refine && !opts->exact) {
+        uint32_t n;
+        const int hit = trace_occluded_for(traverse)(tree, r, an, &n);
+        *steps += n;
+        return hit;
+    }
+    trace_hit h;
+    if (!traverse)
+        traverse = trace_impls[0].traverse;
+    traverse(tree, opts, r, an, &h);
+    *steps += h.steps;
+    return h.hit;
+}
+
 int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                    const double o[3], const double d[3], double t_max, uint64_t *steps)
 {
@@ -108,12 +125,7 @@ int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_
         return 0; /* the ray misses the cube */
     if (t_max < INFINITY && !trace_clip(&r, 0.0, t_max))
         return 0;
-    trace_hit h;
-    if (!traverse)
-        traverse = trace_impls[0].traverse;
-    traverse(tree, opts, &r, NULL, &h);
-    *steps += h.steps;
-    return h.hit;
+    return shadow_cast(tree, opts, traverse, &r, NULL, steps);
 }
 
 int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
@@ -124,10 +136,5 @@ int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_trav
         return 0; /* as trace_setup: the ray misses the cube */
     if (t_max < INFINITY && !trace_clip(&r, 0.0, t_max))
         return 0;
-    trace_hit h;
-    if (!traverse)
-        traverse = trace_impls[0].traverse;
-    traverse(tree, opts, &r, &s->anchor, &h);
-    *steps += h.steps;
-    return h.hit;
+    return shadow_cast(tree, opts, traverse, &r, &s->anchor, steps);
 }

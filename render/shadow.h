@@ -71,6 +71,13 @@ int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float 
                         const float n[3], shadow_start *s);
 int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s);
 
+/* 1 when the prepared ray r, started at anchor an (or NULL), meets an
+ * occupied voxel by opts' rule: under the paper's rule the any-hit walk of
+ * traverse's implementation (trace_impl.h), else traverse itself (NULL:
+ * the build's preferred implementation). Adds its steps to *steps. */
+int shadow_cast(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
+                const trace_ray *r, const trace_anchor *an, uint64_t *steps);
+
 /* 1 when the ray o + t d (d unit), 0 <= t <= t_max (+inf allowed), meets an
  * occupied voxel (by opts' rule), traced by `traverse` (NULL: the build's
  * preferred implementation); 0 otherwise. Adds its DDA steps to *steps. */

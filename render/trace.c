@@ -18,11 +18,19 @@
 
 const trace_impl trace_impls[] = {
 #if TRACE_HAVE_SSE
-    {"sse", trace_traverse_sse},
+    {"sse", trace_traverse_sse, trace_occluded_sse},
 #endif
-    {"portable", trace_traverse_portable},
+    {"portable", trace_traverse_portable, trace_occluded_portable},
 };
 const unsigned trace_impl_count = sizeof trace_impls / sizeof trace_impls[0];
+
+trace_occluded_fn trace_occluded_for(trace_traverse_fn fn)
+{
+    for (unsigned k = 0; k < trace_impl_count; k++)
+        if (trace_impls[k].traverse == fn)
+            return trace_impls[k].occluded;
+    return trace_impls[0].occluded;
+}
 
 int trace_ray_prepared(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
                        trace_hit *hit)

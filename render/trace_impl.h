@@ -41,13 +41,51 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
                        const trace_anchor *anchor, trace_hit *hit);
 #endif
 
+/* The any-hit walk of secondary rays (shadow and AO rays, the paper's rule:
+ * neither --refine nor --exact): 1 when the ray meets an occupied voxel
+ * between r->t_start and r->t_end, which is when the traversal above hits
+ * one, 0 otherwise. It starts in the anchor's cell (anchor not NULL, depth
+ * > 0; else at the root) and skips every occupied cell the ray crosses
+ * without meeting an occupied child (trace_path_children); a cell whose
+ * children are voxels so answers at once (unless two of its mid planes
+ * are crossed at one time: then its voxels are walked). *steps gets its
+ * own step count (it takes fewer steps than the traversal). */
+typedef int (*trace_occluded_fn)(const oct_tree *tree, const trace_ray *r,
+                                 const trace_anchor *anchor, uint32_t *steps);
+
+int trace_occluded_portable(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
+                            uint32_t *steps);
+#if TRACE_HAVE_SSE
+int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
+                       uint32_t *steps);
+#endif
+
+/* The children a ray visits in a cell, from the order of its mid-plane
+ * times (render/trace_path.c): entry c0 | crossed << 3 | order << 6, where
+ * c0 is the child it enters (x + 2y + 4z), crossed the axes whose mid plane
+ * it crosses before it leaves the cell or passes t_end, and order the bits
+ * T_x(mid) < T_y(mid), T_y(mid) < T_z(mid), T_x(mid) < T_z(mid). Child k is
+ * visited when bit k is set; for tied mid-plane times (the ray passes an
+ * edge or a corner between children) the set holds a child it only touches
+ * too: a superset, never a child short. */
+extern const uint8_t trace_path_children[512];
+
+/* The pairs of a crossed set, as the bits x-y, y-z, x-z: where a tie among
+ * their mid-plane times makes trace_path_children a superset. */
+#define TRACE_PAIRS(crossed) (0x72401000u >> (4u * (crossed)) & 7u)
+
 /* Every implementation built into this binary, the one in use first. */
 typedef struct trace_impl {
     const char *name;
     trace_traverse_fn traverse;
+    trace_occluded_fn occluded; /* its any-hit walk */
 } trace_impl;
 extern const trace_impl trace_impls[];
 extern const unsigned trace_impl_count;
+
+/* The any-hit walk of the implementation whose traversal is fn, the
+ * preferred one for NULL or a traversal not in trace_impls. */
+trace_occluded_fn trace_occluded_for(trace_traverse_fn fn);
 
 /* trace_setup_eye without its shortcut for an eye inside the root cube:
  * the tests compare the two. */

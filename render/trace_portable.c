@@ -240,3 +240,135 @@ int trace_traverse_portable(const oct_tree *tree, const trace_opts *opts, const 
     hit->steps = steps;
     return hit->hit;
 }
+
+/* The any-hit walk (trace_impl.h), trace_occluded_sse's steps in plain C:
+ * each occupied cell's children on the ray's way (trace_path_children)
+ * tested against its mask before it is entered. */
+int trace_occluded_portable(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
+                            uint32_t *steps_out)
+{
+    const unsigned levels = tree->levels;
+    uint32_t steps = 0, mn;
+    uint64_t pn;
+    int hit = 0;
+    *steps_out = 0;
+    if (tree->node_count[0] == 0)
+        return 0;
+    const uint32_t max_steps = trace_max_steps(levels);
+    const double t_end = r->t_end;
+    walk w;
+    w.far = 0;
+    for (int a = 0; a < 3; a++) {
+        const int act = r->active >> a & 1;
+        w.zo[a] = act ? r->ot[a] : (double)r->v[a] + 0.5;
+        w.zi[a] = act ? r->inv[a] : INFINITY;
+        w.far |= (r->sgn[a] > 0 ? 1u : 0u) << a;
+        w.v[a] = 0;
+    }
+    w.mask = tree->groups[0][0].mask[0];
+    w.prefix = tree->groups[0][0].base;
+    w.fr[0].mask = w.mask;
+    w.fr[0].prefix = w.prefix;
+    w.fr[0].ci = 0;
+    w.size = UINT32_C(1) << levels;
+    double tc = r->t_start;
+    if (anchor && anchor->depth) {
+        /* the anchor's cell is the current one: tested like any other */
+        w.d = anchor->depth;
+        memcpy(w.fr, anchor->node, (w.d + 1) * sizeof w.fr[0]);
+        w.size = UINT32_C(1) << (levels - w.d);
+        memcpy(w.v, anchor->cell, sizeof w.v);
+        cell_exits(&w, w.v, w.size, w.t);
+        cell_exits(&w, w.v, 2u * w.size, w.tp);
+        w.ci = w.fr[w.d].ci;
+        w.mask = w.fr[w.d - 1].mask;
+        w.prefix = w.fr[w.d - 1].prefix;
+        mn = w.fr[w.d].mask;
+        pn = w.fr[w.d].prefix;
+        goto look;
+    }
+    /* from the root, tested like any other cell */
+    w.d = 0;
+    w.ci = 0;
+    cell_exits(&w, w.v, w.size, w.t);
+    mn = w.mask;
+    pn = w.prefix;
+    goto look;
+    for (;;) {
+        if (w.mask >> w.ci & 1u) {
+            if (w.d == levels) {
+                hit = 1; /* entered after a tie above */
+                break;
+            }
+            const uint64_t n = w.prefix + oct_popcount64(w.mask & ((1u << w.ci) - 1u));
+            const oct_children ch = oct_node_children(tree->groups[w.d], n);
+            mn = ch.mask;
+            pn = ch.first;
+        look:;
+            /* enter's mid-plane times, and the children they make the ray visit */
+            const uint32_t half = w.size >> 1;
+            double lim = min3(w.t);
+            if (t_end < lim)
+                lim = t_end;
+            double tm[3];
+            unsigned c0 = 0, crossed = 0;
+            for (int a = 0; a < 3; a++) {
+                tm[a] = plane_time(&w, a, w.v[a] + half);
+                const unsigned near = tc < tm[a];
+                c0 |= (near ^ (w.far >> a & 1u)) << a;
+                crossed |= (unsigned)(near && tm[a] < lim) << a;
+            }
+            const unsigned order = (unsigned)(tm[0] < tm[1]) | (unsigned)(tm[1] < tm[2]) << 1 |
+                                   (unsigned)(tm[0] < tm[2]) << 2;
+            if (!(trace_path_children[c0 | crossed << 3 | order << 6] & mn)) {
+                if (!w.d)
+                    break; /* the root */
+                goto step; /* nothing on the way: as an empty cell */
+            }
+            if (w.d + 1 == levels) {
+                /* the set is exact unless two crossed mid planes tie */
+                const unsigned eq = (unsigned)(tm[0] == tm[1]) | (unsigned)(tm[1] == tm[2]) << 1 |
+                                    (unsigned)(tm[0] == tm[2]) << 2;
+                if (!(eq & TRACE_PAIRS(crossed))) {
+                    hit = 1; /* a voxel on the way */
+                    break;
+                }
+            }
+            /* push the cell and enter its child c0 (enter's rule) */
+            w.fr[w.d].mask = mn;
+            w.fr[w.d].prefix = pn;
+            w.fr[w.d].ci = w.ci;
+            w.mask = mn;
+            w.prefix = pn;
+            for (int a = 0; a < 3; a++) {
+                w.tp[a] = w.t[a];
+                if ((c0 ^ w.far) >> a & 1u) /* near half: the mid plane is its exit */
+                    w.t[a] = tm[a];
+                w.v[a] |= (0u - (c0 >> a & 1u)) & half;
+            }
+            w.ci = c0;
+            w.size = half;
+            w.d++;
+            continue;
+        }
+    step:;
+        const double te = min3(w.t);
+        if (te >= t_end || ++steps > max_steps)
+            break;
+        unsigned smask = 0;
+        for (int a = 0; a < 3; a++)
+            smask |= (unsigned)(w.t[a] == te) << a;
+        if ((~(w.ci ^ w.far) & smask) && !climb(&w, te, &smask))
+            break;
+        w.ci ^= smask;
+        for (int a = 0; a < 3; a++) {
+            if (smask >> a & 1u) {
+                w.t[a] = w.tp[a];
+                w.v[a] ^= w.size;
+            }
+        }
+        tc = te;
+    }
+    *steps_out = steps;
+    return hit;
+}

@@ -325,4 +325,155 @@ out:;
     hit->steps = steps;
     return hit->hit;
 }
+/* The any-hit walk (trace_impl.h): trace_traverse_sse's steps, enter and
+ * climb, with each occupied cell tested before it is entered: the children
+ * the ray visits in it (trace_path_children, from enter's mid-plane times)
+ * against its child mask. None occupied: the cell is left as if empty; a
+ * cell of voxels with one: the ray meets it. Plain rule only, every empty
+ * cell skipped whole (the split does not change the answer). */
+int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
+                       uint32_t *steps_out)
+{
+    const unsigned levels = tree->levels;
+    int hit = 0;
+    *steps_out = 0;
+    if (tree->node_count[0] == 0)
+        return 0;
+    const uint32_t max_steps = trace_max_steps(levels);
+    uint32_t left = max_steps; /* steps left: counted down */
+    const double t_end = r->t_end;
+    const __m128d TEND = _mm_set1_pd(t_end);
+    const oct_group *const *groups = tree->groups;
+
+    sse_axes ax;
+    __m128d TPxy, TPzw;
+    sse_axes_init(r, levels, &ax, &TPxy, &TPzw);
+    const unsigned far = ax.far;
+
+    trace_frame fr[OCT_MAX_LEVELS];
+    uint32_t M = groups[0][0].mask[0], Mn;
+    uint64_t P = groups[0][0].base, Pn;
+    fr[0].mask = M;
+    fr[0].prefix = P;
+    fr[0].ci = 0;
+    unsigned d = 0, ci = 0;
+    uint32_t size = UINT32_C(1) << levels;
+    __m128i V = _mm_setzero_si128();
+    __m128d Txy, Tzw, TC = _mm_set1_pd(r->t_start);
+
+    if (anchor && anchor->depth) {
+        /* the anchor's cell is the current one: tested like any other */
+        d = anchor->depth;
+        unsigned k = 0;
+        for (; k < d; k += 2) { /* two frames a turn: frames 0..d, d < OCT_MAX_LEVELS */
+            _mm_storeu_si128((__m128i *)(void *)&fr[k],
+                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k]));
+            _mm_storeu_si128((__m128i *)(void *)&fr[k + 1],
+                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k + 1]));
+        }
+        if (k == d)
+            _mm_storeu_si128((__m128i *)(void *)&fr[k],
+                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k]));
+        size = UINT32_C(1) << (levels - d);
+        V = _mm_setr_epi32((int32_t)anchor->cell[0], (int32_t)anchor->cell[1],
+                           (int32_t)anchor->cell[2], 0);
+        trace_cell_exits(V, size, &ax, &Txy, &Tzw);
+        trace_cell_exits(V, 2u * size, &ax, &TPxy, &TPzw);
+        ci = fr[d].ci;
+        M = fr[d - 1].mask;
+        P = fr[d - 1].prefix;
+        Mn = fr[d].mask;
+        Pn = fr[d].prefix;
+        goto look;
+    }
+    /* from the root, tested like any other cell */
+    Txy = TPxy;
+    Tzw = TPzw;
+    Mn = M;
+    Pn = P;
+    goto look;
+    for (;;) {
+        if (M >> ci & 1u) {
+            if (d == levels) {
+                hit = 1; /* entered after a tie above */
+                break;
+            }
+            const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+            const oct_children ch = oct_node_children(groups[d], n);
+            Mn = ch.mask;
+            Pn = ch.first;
+        look:;
+            /* enter's mid-plane times, and the children they make the ray visit */
+            const uint32_t half = size >> 1;
+            const __m128i H = _mm_set1_epi32((int32_t)half);
+            const __m128i MID = _mm_add_epi32(V, H);
+            const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ax.ZOxy), ax.ZIxy);
+            const __m128d TMzw = _mm_mul_pd(
+                _mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ax.ZOzw), ax.ZIzw);
+            const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw);
+            const __m128d m2 = _mm_min_pd(Txy, Tzw);
+            const __m128d LIM = _mm_min_pd(_mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)), TEND);
+            /* one 32-bit lane per axis (w: 0) for each mask, read by one movemask */
+            const __m128 Nv = _mm_shuffle_ps(_mm_castpd_ps(Nxy), _mm_castpd_ps(Nzw),
+                                             _MM_SHUFFLE(2, 0, 2, 0));
+            const __m128 Cv = _mm_and_ps(
+                Nv, _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TMxy, LIM)),
+                                   _mm_castpd_ps(_mm_cmplt_pd(TMzw, LIM)), _MM_SHUFFLE(2, 0, 2, 0)));
+            const __m128 Ov = _mm_shuffle_ps(
+                _mm_castpd_ps(_mm_cmplt_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))),
+                _mm_castpd_ps(_mm_cmplt_pd(TMxy, TMzw)), _MM_SHUFFLE(0, 0, 2, 0));
+            const unsigned c0 = (unsigned)_mm_movemask_ps(Nv) ^ far;
+            const unsigned crossed = (unsigned)_mm_movemask_ps(Cv);
+            const unsigned order = (unsigned)_mm_movemask_ps(Ov) & 7u;
+            if (!(trace_path_children[c0 | crossed << 3 | order << 6] & Mn)) {
+                if (!d)
+                    break; /* the root */
+                goto step; /* nothing on the way: as an empty cell */
+            }
+            if (d + 1 == levels) {
+                /* the set is exact unless two crossed mid planes tie */
+                const unsigned eq =
+                    (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))) |
+                    ((unsigned)_mm_movemask_pd(_mm_cmpeq_sd(TMxy, TMzw)) & 1u) << 2;
+                if (!(eq & TRACE_PAIRS(crossed))) {
+                    hit = 1; /* a voxel on the way */
+                    break;
+                }
+            }
+            /* push the cell and enter its child c0 (enter's blend) */
+            fr[d].mask = Mn;
+            fr[d].prefix = Pn;
+            fr[d].ci = ci;
+            M = Mn;
+            P = Pn;
+            TPxy = Txy;
+            TPzw = Tzw;
+            Txy = _mm_blendv_pd(TPxy, TMxy, Nxy);
+            Tzw = _mm_blendv_pd(TPzw, TMzw, Nzw);
+            ci = c0;
+            V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[ci])));
+            size = half;
+            d++;
+            continue;
+        }
+    step:;
+        const __m128d s2 = _mm_min_pd(Txy, Tzw);
+        const __m128d TEv = _mm_min_pd(s2, _mm_shuffle_pd(s2, s2, 1));
+        if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
+            break;
+        __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
+        unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+        if ((~(ci ^ far) & smask) && !climb(fr, &ax, TEv, &d, &ci, &size, &V, &smask, &Exy, &Ezw,
+                                             &Txy, &Tzw, &TPxy, &TPzw, &M, &P))
+            break;
+        ci ^= smask;
+        Txy = _mm_blendv_pd(Txy, TPxy, Exy);
+        Tzw = _mm_blendv_pd(Tzw, TPzw, Ezw);
+        V = _mm_xor_si128(V, _mm_and_si128(_mm_set1_epi32((int32_t)size),
+                                           _mm_load_si128((const __m128i *)trace_lut[smask])));
+        TC = TEv;
+    }
+    *steps_out = max_steps - left; /* max_steps + 1 when the bound was passed */
+    return hit;
+}
 #endif

@@ -54,6 +54,29 @@ static int same_hit(const oct_tree *tree, const trace_hit *a, const trace_hit *b
     return a->voxel == b->voxel && (a->t == b->t || (isnan(a->t) && isnan(b->t)));
 }
 
+/* The any-hit walk of every implementation, from the anchor and from the
+ * root: the traversal's answer (hit), and one step count for all. */
+static void check_occluded(const oct_tree *tree, const trace_ray *r, const trace_anchor *a,
+                           const trace_hit *hit)
+{
+    uint32_t steps0 = 0;
+    for (unsigned i = 0; i < trace_impl_count; i++)
+        for (int root = 0; root <= (a != NULL); root++) {
+            uint32_t steps;
+            const int occ = trace_impls[i].occluded(tree, r, root ? NULL : a, &steps);
+            if (i == 0 && root == 0)
+                steps0 = steps;
+            if (occ != hit->hit || steps != steps0) {
+                fprintf(stderr,
+                        "any-hit walk differs (anchor depth %u, %s, %s): occluded %d steps %u; "
+                        "traversal hit %d, first walk's steps %u\n",
+                        a ? a->depth : 0u, root ? "from the root" : "from the anchor",
+                        trace_impls[i].name, occ, steps, hit->hit, steps0);
+                abort();
+            }
+        }
+}
+
 static int run_all(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
                    const trace_anchor *a, trace_hit *hit)
 {
@@ -71,6 +94,8 @@ static int run_all(const oct_tree *tree, const trace_opts *opts, const trace_ray
             abort();
         }
     }
+    if (!opts->refine && !opts->exact)
+        check_occluded(tree, r, a, hit);
     return hit->hit;
 }
 

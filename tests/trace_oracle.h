@@ -21,7 +21,10 @@ long trace_oracle_first(const trace_ray *r, unsigned levels, const uint32_t (*vo
 
 /* trace_ray_cast, trace_ray_prepared and trace_ray_anchored run on every
  * implementation; aborts with a message when two differ in hit, voxel, xyz,
- * t or steps. The result is the implementation in use's. */
+ * t or steps. Under the paper's rule each implementation's any-hit walk
+ * (trace_impl.h) runs too, from the anchor and from the root, and must give
+ * the traversal's answer with one step count for all. The result is the
+ * implementation in use's. */
 int trace_cast_all(const oct_tree *tree, const trace_opts *opts, const double eye[3],
                    const double dir[3], trace_hit *hit);
 int trace_prepared_all(const oct_tree *tree, const trace_opts *opts, const trace_ray *r,
