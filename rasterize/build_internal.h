@@ -184,6 +184,11 @@ typedef struct retest_item {
  * plain_test_drops: the plain interval test over each cell's box (no point of
  * the surface where f is defined), on voxels or on a node's children. Same
  * decisions and counts as testing the cells one by one. */
+/* 1 when centred_form_drops would keep the voxel (box, centre cv) whatever
+ * f at cv is found to be, from the node's form (fc at centre c, G) alone:
+ * then f(cv) need not be evaluated for it (an fd of NaN keeps it). */
+int centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
+                                const interval box[3], const double cv[3]);
 void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
                         unsigned n, uint8_t *drop);
 void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,

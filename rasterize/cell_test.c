@@ -58,6 +58,33 @@ static int centred_form_may_exclude(const interval G[3], const interval box[3],
     return !(fd + m + wlo <= 0.0 && fd - m + whi >= 0.0); /* false on NaN or inf */
 }
 
+/* Whether the form centred on the voxel fails whatever f([cv]) the tape
+ * gives, judged without evaluating it: f(cv) lies in E = fc + G . (cv - c),
+ * the node's form at that point (fc an enclosure of f at the form's centre
+ * c, G of the gradient over a box holding c and the voxel), and f([cv]).lo
+ * <= f(cv) <= f([cv]).hi. The form's lower end is at most f([cv]).lo +
+ * sum_k min(G_k x (box_k - cv_k)) <= E.hi + that sum, its upper end at
+ * least E.lo + sum_k max(...). When the first bound is <= 0 and the second
+ * >= 0, the form cannot exclude 0: centred_form_drops keeps the voxel
+ * whatever f([cv]) is, so its value need not be made. The sums are in plain
+ * double with a margin far above their rounding (and above flushed
+ * subnormals); a non-finite term gives 0 (evaluate). */
+int centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
+                                const interval box[3], const double cv[3])
+{
+    double up = fc.hi, lo = fc.lo, mag = fabs(fc.lo) + fabs(fc.hi);
+    for (int k = 0; k < 3; k++) {
+        double d = cv[k] - c[k], rl = box[k].lo - cv[k], rh = box[k].hi - cv[k];
+        double e1 = G[k].lo * d, e2 = G[k].hi * d;
+        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
+        up += max2(e1, e2) + min2(min2(p1, p2), min2(p3, p4));
+        lo += min2(e1, e2) + max2(max2(p1, p2), max2(p3, p4));
+        mag += (fabs(G[k].lo) + fabs(G[k].hi)) * (fabs(d) + fabs(rl) + fabs(rh));
+    }
+    double margin = 0x1p-40 * mag + 0x1p-1000;
+    return up + margin <= 0.0 && lo - margin >= 0.0; /* false on NaN */
+}
+
 /* The form itself, from fc = f([c]) and its flags fl. */
 static int centred_form_excludes(interval fc, unsigned fl, const interval G[3],
                                  const interval box[3], const double centre[3])

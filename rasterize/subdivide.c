@@ -16,6 +16,36 @@ _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradie
 
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3]);
 
+/* f and its gradient at n voxel centres (tape_eval_grad_lanes). With
+ * --shell-only and one surface only f is wanted (the centred re-test's
+ * skip; no record, no choice of surface): the value evaluator, the same
+ * bits of f, and the gradients left 0. */
+static void centre_values(worker *wk, const tape *t, unsigned n, const double *x, const double *y,
+                          const double *z, double *f, double g[3][TAPE_LANES])
+{
+    wk->st.point_evals += n;
+    if (wk->c->par->shell_only && wk->c->nsurf == 1) {
+        tape_eval_lanes(t, n, x, y, z, f, wk->lslots);
+        memset(g, 0, 3 * sizeof *g);
+        return;
+    }
+    tape_eval_grad_lanes(t, n, x, y, z, f, g, wk->lslots);
+}
+
+/* With --shell-only and one surface, f at child i's centre serves only the
+ * centred re-test: where the node's form (fc at centre c, G) shows that the
+ * re-test keeps the child whatever f is there, 1 is returned (the re-test is
+ * not run, no evaluation) and fg, its entry of cf8, is filled with zeros. */
+static int skip_centre(const worker *wk, interval fc, const interval G[3], const double c[3],
+                       const child_boxes *cb, unsigned i, double fg[4])
+{
+    if (!wk->c->par->shell_only || wk->c->nsurf != 1 ||
+        !centred_form_cannot_exclude(fc, G, c, cb->box[i], cb->centre[i]))
+        return 0;
+    fg[0] = fg[1] = fg[2] = fg[3] = 0.0;
+    return 1;
+}
+
 /* For a leaf-parent: f and its gradient at the centres of the children that
  * the mean-value form leaves to the centred re-test, surface by surface, one
  * pass over the tape for all of them (tape_eval_grad_lanes), into wk->cf8. */
@@ -40,8 +70,7 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
         }
         if (!n)
             continue;
-        tape_eval_grad_lanes(c->full[s], n, x, y, z, f, g, wk->lslots);
-        wk->st.point_evals += n;
+        centre_values(wk, c->full[s], n, x, y, z, f, g);
         for (unsigned l = 0; l < n; l++) {
             double *fg = wk->cf8 + ((size_t)s * 8 + lane[l]) * 4;
             fg[0] = f[l];
@@ -157,7 +186,7 @@ typedef struct leaf_parent {
     unsigned slot; /* which child of its parent */
     interval pbox[3], T[1][8];
     double pc[3];
-    uint8_t ok[1], cand, cf8_have, centred[1], plain[1];
+    uint8_t ok[1], cand, nofd, cf8_have, centred[1], plain[1]; /* nofd: see skip_centre */
     child_boxes cb;
     double cf8[32];
 } leaf_parent;
@@ -242,36 +271,61 @@ static void push_mask(worker *wk, unsigned depth, uint8_t mask)
     }
 }
 
-/* The leaf-parents (depth = levels - 1) of one node of a single-surface
- * scene, each what visit_mean_value would make of it, with the evaluations
- * pooled: f and its gradient at the candidate voxels' centres of all of
- * them, in passes of TAPE_LANES points, then their re-tests likewise. The
- * node's own form serves them all (their reuse). Returns the node's mask
- * bits for them; their masks and voxels go out in slot order. */
-static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
+/* --shell-only: what visit_children makes of a leaf-parent of a
+ * single-surface batch whose form was available (p->ok), without its
+ * per-child bookkeeping: the children the form and the re-tests left are
+ * its voxels, each an empty record, and its mask. */
+static unsigned bits8(uint8_t m)
+{
+    unsigned n = 0;
+    for (; m; m &= (uint8_t)(m - 1))
+        n++;
+    return n;
+}
+
+static uint8_t shell_voxels(worker *wk, const leaf_parent *p)
+{
+    static const uint32_t empty[8];
+    unsigned form_drops = 0;
+    for (unsigned i = 0; i < 8; i++)
+        form_drops += p->T[0][i].lo > 0.0 || p->T[0][i].hi < 0.0;
+    uint8_t keep = (uint8_t)(p->cand & ~(p->centred[0] | p->plain[0]));
+    unsigned n = bits8(keep);
+    wk->st.taylor_drops += form_drops + bits8(p->centred[0]);
+    if (n && buf_push(&wk->out->voxels, empty, n * sizeof *empty)) {
+        wk->failed = 1;
+        return 0;
+    }
+    wk->st.voxels += n;
+    return keep;
+}
+
+/* For leaf_batch: the leaf-parents' forms (the node's, reused), their
+ * candidate voxels, and f and its gradient at the centres of those that
+ * need them (not skip_centre's), in passes of TAPE_LANES points. */
+static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
 {
     const build_ctx *c = wk->c;
     const unsigned pidx = depth + 1;
     const tape *t = &wk->tapes[pidx], *full = c->full[0];
     interval *G = &wk->grad[pidx * 3];
-    memcpy(G, &wk->grad[depth * 3], 3 * sizeof *G);
-    wk->fcen[pidx] = wk->fcen[depth];
     double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
-    unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES], nit = 0;
-    retest_item it[64];
-    uint8_t it_lp[64], it_ch[64], drop[64];
+    unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES];
     for (unsigned b = 0; b < nb; b++) {
         leaf_parent *p = &lp[b];
         cell_box(c, depth, p->cell, p->pbox, p->pc);
         p->ok[0] = (uint8_t)child_enclosures(wk, t, p->pbox, depth, p->cell, wk->ncen[depth],
                                              &wk->fcen[pidx], G, 1, p->T[0]);
         child_boxes_init(c, depth, p->cell, p->pbox, &p->cb);
-        p->cand = p->cf8_have = p->centred[0] = p->plain[0] = 0;
+        p->cand = p->nofd = p->cf8_have = p->centred[0] = p->plain[0] = 0;
         for (unsigned i = 0; i < 8 && p->ok[0]; i++)
             if (!(p->T[0][i].lo > 0.0 || p->T[0][i].hi < 0.0) && child_box(&p->cb, i))
                 p->cand |= (uint8_t)(1u << i);
         for (unsigned i = 0; i < 8; i++) { /* f and grad f at the candidates' centres */
-            if ((p->cand >> i) & 1) {
+            if (((p->cand >> i) & 1) && skip_centre(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, i,
+                                                     p->cf8 + 4 * i)) {
+                p->nofd |= (uint8_t)(1u << i);
+            } else if ((p->cand >> i) & 1) {
                 x[n] = p->cb.centre[i][0];
                 y[n] = p->cb.centre[i][1];
                 z[n] = p->cb.centre[i][2];
@@ -279,8 +333,7 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
                 ch[n++] = i;
             }
             if (n == TAPE_LANES || (n && b + 1 == nb && i == 7)) {
-                tape_eval_grad_lanes(full, n, x, y, z, f, g, wk->lslots);
-                wk->st.point_evals += n;
+                centre_values(wk, full, n, x, y, z, f, g);
                 for (unsigned l = 0; l < n; l++) {
                     leaf_parent *q = &lp[owner[l]];
                     double *fg = q->cf8 + 4 * ch[l];
@@ -294,16 +347,37 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
             }
         }
     }
-    for (unsigned b = 0; b < nb; b++) /* the re-tests' candidates */
+}
+
+/* For leaf_batch: the re-tests of all the leaf-parents' candidates at
+ * once: the centred form on those with f at their centre, then on a kinked
+ * tape the plain test on all that the form left. */
+static void batch_retests(worker *wk, unsigned pidx, leaf_parent *lp, unsigned nb)
+{
+    const tape *t = &wk->tapes[pidx];
+    const interval *G = &wk->grad[pidx * 3];
+    unsigned nit = 0;
+    retest_item it[64];
+    uint8_t it_lp[64], it_ch[64], drop[64];
+    unsigned m = 0, nfd = 0, fdj[64];
+    retest_item fit[64];
+    uint8_t fdrop[64];
+    for (unsigned b = 0; b < nb; b++)
         for (unsigned i = 0; i < 8; i++)
             if ((lp[b].cand >> i) & 1) {
                 retest_item r = {lp[b].cb.box[i], lp[b].cb.centre[i], lp[b].cf8[4 * i]};
                 it_lp[nit] = (uint8_t)b;
                 it_ch[nit] = (uint8_t)i;
+                drop[nit] = 0;
+                if (!((lp[b].nofd >> i) & 1)) {
+                    fdj[nfd] = nit;
+                    fit[nfd++] = r;
+                }
                 it[nit++] = r;
             }
-    centred_form_drops(wk, t, G, it, nit, drop);
-    unsigned m = 0;
+    centred_form_drops(wk, t, G, fit, nfd, fdrop);
+    for (unsigned j = 0; j < nfd; j++)
+        drop[fdj[j]] = fdrop[j];
     for (unsigned j = 0; j < nit; j++) {
         if (drop[j]) {
             lp[it_lp[j]].centred[0] |= (uint8_t)(1u << it_ch[j]);
@@ -319,10 +393,33 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
             if (drop[j])
                 lp[it_lp[j]].plain[0] |= (uint8_t)(1u << it_ch[j]);
     }
+}
+
+/* The leaf-parents (depth = levels - 1) of one node of a single-surface
+ * scene, each what visit_mean_value would make of it, with the evaluations
+ * pooled: f and its gradient at the candidate voxels' centres of all of
+ * them, in passes of TAPE_LANES points, then their re-tests likewise. The
+ * node's own form serves them all (their reuse). Returns the node's mask
+ * bits for them; their masks and voxels go out in slot order. */
+static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
+{
+    const build_ctx *c = wk->c;
+    const unsigned pidx = depth + 1;
+    memcpy(&wk->grad[pidx * 3], &wk->grad[depth * 3], 3 * sizeof *wk->grad);
+    wk->fcen[pidx] = wk->fcen[depth];
+    batch_centres(wk, depth, lp, nb);
+    batch_retests(wk, pidx, lp, nb);
     double *cf8 = wk->cf8;
     uint8_t mask = 0;
     for (unsigned b = 0; b < nb && !wk->failed; b++) {
         leaf_parent *p = &lp[b];
+        if (c->par->shell_only && p->ok[0]) { /* no record: only the mask and the count */
+            uint8_t pm = shell_voxels(wk, p);
+            push_mask(wk, depth, pm);
+            if (pm)
+                mask |= (uint8_t)(1u << p->slot);
+            continue;
+        }
         memcpy(wk->ncen[pidx], p->pc, sizeof p->pc);
         wk->grad_ok[pidx] = p->ok[0];
         wk->act[pidx] = 0;

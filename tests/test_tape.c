@@ -368,20 +368,23 @@ static int same_bits(double a, double b)
     return memcmp(&a, &b, sizeof a) == 0 || (isnan(a) && isnan(b));
 }
 
-/* tape_eval_grad_lanes gives, lane by lane, tape_eval_grad's bits: random
- * trees (every operation) and the scenes, with 1 to TAPE_LANES points. */
+/* tape_eval_grad_lanes gives, lane by lane, tape_eval_grad's bits, and
+ * tape_eval_lanes tape_eval's (the same f): random trees (every operation)
+ * and the scenes, with 1 to TAPE_LANES points. */
 static void check_lanes(const tape *t, const double pts[][3], unsigned n, const char *what)
 {
     static tape_dual_lanes lslots[MAXSLOTS];
     static tape_dual duals[MAXSLOTS];
+    static double vslots[MAXSLOTS];
     double x[TAPE_LANES] = {0}, y[TAPE_LANES] = {0}, z[TAPE_LANES] = {0}; /* lanes past n: unread */
-    double f[TAPE_LANES], g[3][TAPE_LANES];
+    double f[TAPE_LANES], g[3][TAPE_LANES], fv[TAPE_LANES];
     for (unsigned l = 0; l < n; l++) {
         x[l] = pts[l][0];
         y[l] = pts[l][1];
         z[l] = pts[l][2];
     }
     tape_eval_grad_lanes(t, n, x, y, z, f, g, lslots);
+    tape_eval_lanes(t, n, x, y, z, fv, lslots);
     for (unsigned l = 0; l < n; l++) {
         double g1[3], f1 = tape_eval_grad(t, pts[l], g1, duals);
         if (!same_bits(f[l], f1) || !same_bits(g[0][l], g1[0]) || !same_bits(g[1][l], g1[1]) ||
@@ -389,6 +392,10 @@ static void check_lanes(const tape *t, const double pts[][3], unsigned n, const 
             fail_msg("%s lane %u of %u at (%a,%a,%a): %a (%a,%a,%a) vs %a (%a,%a,%a)", what, l, n,
                      pts[l][0], pts[l][1], pts[l][2], f[l], g[0][l], g[1][l], g[2][l], f1, g1[0],
                      g1[1], g1[2]);
+        double f0 = tape_eval(t, pts[l][0], pts[l][1], pts[l][2], vslots);
+        if (!same_bits(fv[l], f0) || !same_bits(f0, f1))
+            fail_msg("%s value lane %u of %u at (%a,%a,%a): %a, tape_eval %a, grad %a", what, l, n,
+                     pts[l][0], pts[l][1], pts[l][2], fv[l], f0, f1);
     }
 }
 

@@ -127,6 +127,13 @@ typedef struct tape_dual_lanes {
 void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
                           const double y[TAPE_LANES], const double z[TAPE_LANES],
                           double f[TAPE_LANES], double g[3][TAPE_LANES], tape_dual_lanes *slots);
+/* tape_eval at up to TAPE_LANES points at once: lane l of f is, bit for bit,
+ * tape_eval at (x[l], y[l], z[l]) (and tape_eval_grad_lanes's f) for l < n,
+ * without the gradient's cost. `slots` as for tape_eval_grad_lanes (only
+ * their values are written). */
+void tape_eval_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
+                     const double y[TAPE_LANES], const double z[TAPE_LANES], double f[TAPE_LANES],
+                     tape_dual_lanes *slots);
 
 /* Sound enclosure of f over the box box[0] x box[1] x box[2]; *flags
  * receives INTERVAL_MAYBE_NAN when f may be undefined somewhere in the box

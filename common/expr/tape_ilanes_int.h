@@ -50,6 +50,15 @@ void tape_grad_lanes_avx2(const tape *t, unsigned n, const double x[TAPE_LANES],
                           const double y[TAPE_LANES], const double z[TAPE_LANES],
                           double f[TAPE_LANES], double g[3][TAPE_LANES], tape_dual_lanes *s);
 #endif
+/* The lane value evaluator's builds: tape_eval_lanes on one of them. */
+void tape_grad_lanes_portable_value(const tape *t, unsigned n, const double x[TAPE_LANES],
+                                    const double y[TAPE_LANES], const double z[TAPE_LANES],
+                                    double f[TAPE_LANES], tape_dual_lanes *s);
+#if TAPE_ILANES_AVX2
+void tape_grad_lanes_avx2_value(const tape *t, unsigned n, const double x[TAPE_LANES],
+                                const double y[TAPE_LANES], const double z[TAPE_LANES],
+                                double f[TAPE_LANES], tape_dual_lanes *s);
+#endif
 
 /* The definitions of one build (NAME its entry), from tape_ilanes_body.h. */
 #define TAPE_ILANES_DEFINE(NAME)                                                              \

@@ -25,3 +25,16 @@ void tape_eval_grad_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
 #endif
     tape_grad_lanes_portable(t, n, x, y, z, f, g, s);
 }
+
+void tape_eval_lanes(const tape *t, unsigned n, const double x[TAPE_LANES],
+                     const double y[TAPE_LANES], const double z[TAPE_LANES], double f[TAPE_LANES],
+                     tape_dual_lanes *s)
+{
+#if TAPE_ILANES_AVX2
+    if (tape_lanes_path() == TAPE_PATH_AVX2) {
+        tape_grad_lanes_avx2_value(t, n, x, y, z, f, s);
+        return;
+    }
+#endif
+    tape_grad_lanes_portable_value(t, n, x, y, z, f, s);
+}
