@@ -4,9 +4,8 @@
 
 #include <math.h>
 
+#include "common/expr/tape_err.h"
 #include "common/expr/tape_hess.h"
-
-static interval ipt(double x) { interval r = {x, x}; return r; }
 
 double exact_fast_curv(const double mag[6], const double d[3])
 {
@@ -19,118 +18,128 @@ double exact_fast_curv(const double mag[6], const double d[3])
     return s != s ? INFINITY : interval_next_up(s * (1.0 + 0x1p-48));
 }
 
-static double g_at(const tape *t, exact_scratch *w, const exact_line *l, double s)
+/* The bounds below are sums of products of non-negative doubles with fewer
+ * than 20 roundings each: times CM they are at least their exact values. */
+#define U 0x1p-53
+#define CM (1.0 + 0x1p-46)
+
+/* x clamped into [a, b]; NaN gives a. */
+static double clamp(double x, double a, double b) { return x > a ? (x < b ? x : b) : a; }
+
+/* The sign of g at m + s* (s* = t - m exactly, s its rounding: |s - s*| <=
+ * u |s|) when the model certifies it: g(m + s*) = v* + d* s* + R with |R| <=
+ * K s*^2 / 2 (Taylor), |v* - v| <= ev, |d* - d| <= ed, and c = v + d s
+ * rounded twice; rs >= |s| bounds the |s*| of the tail (rs = |s|: at the
+ * point; rs = r: anywhere on a span whose linear part keeps c's sign). */
+static int sign_at(const exact_model *md, double s, double rs, double K)
 {
-    return tape_eval(t, l->o[0] + s * l->d[0], l->o[1] + s * l->d[1], l->o[2] + s * l->d[2],
-                     w->slots);
+    const double ds = md->d * s, c = md->v + ds;
+    const double bnd =
+        (md->ev + (md->ed + 0.5 * K * rs) * rs + U * (fabs(c) + 2.0 * fabs(ds))) * CM;
+    return c > bnd ? 1 : c < -bnd ? -1 : 0;
 }
 
-/* Strictly positive (1), strictly negative (-1), or holding 0 or NaN (0). */
-static int sign_of(interval x)
+static void line_point(const exact_line *l, double x, double p[3], double ep[3])
 {
-    return x.lo > 0.0 ? 1 : x.hi < 0.0 ? -1 : 0;
+    for (int k = 0; k < 3; k++)
+        ep[k] = tape_err_point(l->o[k], x, l->d[k], &p[k]);
 }
 
-/* The root of g in [a, b], where g is certified monotone (g' of sign sg)
- * with one root: one Newton step from x1 (the midpoint's step), whose
- * error is about curv dx^2 / (2 |g'|) plus the rounding noise of g's double
- * evaluation (at most about the width w0 of the midpoint's enclosure over
- * |g'|); the bracket of twice that around it, confirmed by the signs of g
- * at its ends (else widened to an end of [a, b]), is refined to adjacent
- * doubles (exact_refine). 1 with *root, or 0: undecided. */
-static int newton(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                  int sg, double x1, double curv, double w0, double *root)
+/* The root t* of g in [a, b], where g is certified monotone with g' of sign
+ * sg and |g'| >= dmin there: Newton steps from the model's estimate, plain
+ * (tape_eval_dir) while the next step's quadratic error (K err^2 / 2 dmin,
+ * err the predicted error) would exceed the model's noise, then with error
+ * bounds (tape_eval_dir_err) at x: |x - t*| <= rho = (|v| + ev) / dmin, g'
+ * lies within dr = ed + K rho of d between x and t*, and t* - x = -g(x) /
+ * g'(xi) by the mean value theorem: t* lies in x - [v +- ev] / [d +- dr]
+ * (outward-rounded intervals), intersected with [a, b]. Accepted once that
+ * enclosure is no wider than EXACT_FAST_BAND; *root is the Newton point
+ * clamped into it. 1, or 0: undecided. */
+static int place(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                 int sg, double K, double dmin, const exact_model *md, double *root)
 {
-    const double p[3] = {l->o[0] + x1 * l->d[0], l->o[1] + x1 * l->d[1], l->o[2] + x1 * l->d[2]};
-    double dv;
-    const double v = tape_eval_dir(t, p, l->d, &dv, w->dir);
-    if (v == 0.0) {
-        *root = x1;
-        return 1;
-    }
-    if (!(sg > 0 ? dv > 0.0 : dv < 0.0) || v != v || !isfinite(dv))
-        return 0; /* the double derivative disagrees with the certificate */
-    double x2 = x1 - v / dv;
-    x2 = x2 > a ? (x2 < b ? x2 : b) : a;
-    const double dx = x2 - x1, adv = fabs(dv);
-    const double e = 2.0 * (curv * dx * dx / (2.0 * adv) + w0 / adv) +
-                     4.0 * (interval_next_up(fabs(x2)) - fabs(x2));
-    double lo = x2 - e > a ? x2 - e : a, hi = x2 + e < b ? x2 + e : b;
-    double glo = g_at(t, w, l, lo), ghi = g_at(t, w, l, hi);
-    if (glo != glo || ghi != ghi)
-        return 0;
-    if (!(glo == 0.0 || ghi == 0.0 || (glo < 0.0) != (ghi < 0.0))) {
-        /* both on one side of the root: it lies beyond, up to an end */
-        const int below = (glo < 0.0) == (sg > 0); /* g below the root's sign */
-        if (below ? hi == b : lo == a)
-            return 0;
-        if (below) {
-            lo = hi;
-            glo = ghi;
-            hi = b;
-            ghi = g_at(t, w, l, b);
-        } else {
-            hi = lo;
-            ghi = glo;
-            lo = a;
-            glo = g_at(t, w, l, a);
+    double x = clamp(md->m - md->v / md->d, a, b); /* (NaN: a) */
+    double err = K * (x - md->m) * (x - md->m) / (2.0 * dmin);
+    const double noise = 2.0 * md->ev / dmin;
+    double lo = a, hi = b;
+    for (int it = 0; it < 6; it++) {
+        double p[3], ep[3];
+        line_point(l, x, p, ep);
+        if (it < 3 && K * err * err > noise * dmin) {
+            double dv;
+            const double v = tape_eval_dir(t, p, l->d, &dv, w->dir);
+            if (!(sg > 0 ? dv > 0.0 : dv < 0.0) || v != v)
+                return 0; /* the double derivative disagrees with the certificate */
+            x = clamp(x - v / dv, lo, hi);
+            err = K * err * err / (2.0 * dmin);
+            continue;
         }
-        if (!(glo == 0.0 || ghi == 0.0 || (glo < 0.0) != (ghi < 0.0)))
+        tape_edir e;
+        if (!tape_eval_dir_err(t, p, ep, l->d, &e, w->edir))
             return 0;
+        const double rho = (fabs(e.v) + e.ev) / dmin * CM;
+        const double dr = (e.ed + K * rho) * CM;
+        if (!(sg > 0 ? e.d > dr : e.d < -dr))
+            return 0;
+        unsigned f = 0;
+        const interval G = {interval_next_down(e.v - e.ev), interval_next_up(e.v + e.ev)};
+        const interval D = {interval_next_down(e.d - dr), interval_next_up(e.d + dr)};
+        const interval T = interval_sub((interval){x, x}, interval_div(G, D, &f), &f);
+        lo = T.lo > lo ? T.lo : lo;
+        hi = T.hi < hi ? T.hi : hi;
+        if (f || !(lo <= hi))
+            return 0; /* (cannot happen: both hold t*) */
+        x = clamp(x - e.v / e.d, lo, hi);
+        const double ax = fabs(x);
+        if (hi - lo <= EXACT_FAST_BAND(e.ev / fabs(e.d), interval_next_up(ax) - ax)) {
+            *root = x;
+            return 1;
+        }
+        err = hi - lo;
     }
-    const double r = exact_refine(t, w, l, lo, hi, glo, ghi);
-    if (!(r < INFINITY))
-        return 0;
-    *root = r;
-    return 1;
+    return 0;
 }
 
 int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
                      exact_model *model)
 {
-    interval box[3];
-    exact_segment_box(l, m, m, box);
-    unsigned flags = 0;
+    double p[3], ep[3];
+    line_point(l, m, p, ep);
+    tape_edir e;
     model->m = m;
-    model->g = tape_eval_interval_dir(t, box, l->d, &model->dg, w->idir, &flags);
-    return !flags && !interval_is_nan(model->g) && !interval_is_nan(model->dg);
+    if (!tape_eval_dir_err(t, p, ep, l->d, &e, w->edir))
+        return 0;
+    model->v = e.v;
+    model->d = e.d;
+    model->ev = e.ev;
+    model->ed = e.ed;
+    return 1;
 }
 
 int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                       double curv, const exact_model *model, double *root)
 {
-    const double m = model->m;
-    const interval G0 = model->g, G1 = model->dg;
-    unsigned flags = 0;
-    /* g(m + s) in G0 + G1 s + [-1, 1] curv s^2 / 2 for s in [a - m, b - m]
-     * (Taylor with the remainder's bound), and g'(m + s) in G1 + [-1, 1]
-     * curv |s|: all evaluated with outward rounding */
-    const interval Sa = interval_sub(ipt(a), ipt(m), &flags);
-    const interval Sb = interval_sub(ipt(b), ipt(m), &flags);
-    const double r = fmax(-Sa.lo, Sb.hi); /* max |s| (m may lie outside [a, b]) */
-    const double kr = interval_next_up(curv * r);
-    const double q = interval_next_up(interval_next_up(kr * r) * 0.5);
-    const interval Q = {-q, q};
-    const int sg = G1.lo > kr ? 1 : G1.hi < -kr ? -1 : 0;
+    /* g'(m + s) within ed + K |s| of d (Taylor with |g''| <= K), |s| <= r
+     * (1 + u) on the span (m may lie outside it) */
+    const double m = model->m, K = curv;
+    const double sa = a - m, sb = b - m;
+    const double r = fmax(fabs(sa), fabs(sb));
+    const double bd = (model->ed + K * r) * CM;
+    const int sg = model->d > bd ? 1 : model->d < -bd ? -1 : 0;
     if (!sg) {
-        const interval S = {Sa.lo, Sb.hi};
-        const interval G = interval_add(interval_add(G0, interval_mul(G1, S, &flags), &flags), Q,
-                                        &flags);
-        return sign_of(G) && !flags ? EXACT_FAST_NONE : EXACT_FAST_UNDECIDED;
+        /* g's linear part keeps one sign over the span, beyond the tail at r */
+        const int ga = sign_at(model, sa, r, K);
+        return ga && ga == sign_at(model, sb, r, K) ? EXACT_FAST_NONE : EXACT_FAST_UNDECIDED;
     }
-    const int ga = sign_of(interval_add(interval_add(G0, interval_mul(G1, Sa, &flags), &flags), Q,
-                                        &flags));
-    const int gb = sign_of(interval_add(interval_add(G0, interval_mul(G1, Sb, &flags), &flags), Q,
-                                        &flags));
-    if (flags || !ga || !gb)
+    const int ga = sign_at(model, sa, fabs(sa), K), gb = sign_at(model, sb, fabs(sb), K);
+    if (!ga || !gb)
         return EXACT_FAST_UNDECIDED;
     if (ga == gb)
         return EXACT_FAST_NONE; /* monotone, the same sign at both ends */
-    /* one root in (a, b): the first Newton step from the enclosures' midpoints */
-    double x = m - 0.5 * (G0.lo + G0.hi) / (0.5 * (G1.lo + G1.hi));
-    x = x > a ? (x < b ? x : b) : a; /* (NaN: a) */
-    return newton(t, w, l, a, b, sg, x, curv, G0.hi - G0.lo, root) ? EXACT_FAST_ROOT
-                                                                  : EXACT_FAST_UNDECIDED;
+    /* one root in (a, b); |g'| >= |d| - bd there (rounded down) */
+    const double dmin = (fabs(model->d) - bd) * (1.0 - 0x1p-50);
+    return place(t, w, l, a, b, sg, K, dmin, model, root) ? EXACT_FAST_ROOT
+                                                          : EXACT_FAST_UNDECIDED;
 }
 
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,

@@ -2,8 +2,8 @@
  * (RENDER.md, "--exact", "The fast path"): one interval evaluation of g and
  * g' at a point of the line and a bound on |g''| over the coarse cell decide
  * the common cases by Taylor's theorem, for every voxel of the cell along
- * the line; a Newton step inside the certified bracket and a sign change at
- * adjacent doubles place the root. What it cannot decide is left to
+ * the line; Newton steps and an enclosure of the root from an evaluation
+ * with rounding-error bounds place the root. What it cannot decide is left to
  * exact_first_root. */
 #ifndef EXACT_FAST_H
 #define EXACT_FAST_H
@@ -22,11 +22,12 @@ enum {
  * every point tested, rounded up; +inf when those are. */
 double exact_fast_curv(const double mag[6], const double d[3]);
 
-/* A first-order model of g at m: enclosures of g(m) and g'(m) (over the
- * outward-rounded box of the point o + m d). */
+/* A first-order model of g at m: g(m) and g'(m) in double with rigorous
+ * bounds on their errors (tape_eval_dir_err at the computed point o + m d,
+ * whose own rounding is bounded too). */
 typedef struct exact_model {
     double m;
-    interval g, dg;
+    double v, d, ev, ed; /* |g(m) - v| <= ev, |g'(m) - d| <= ed */
 } exact_model;
 
 /* Fills *model at m: 1, or 0 when the evaluation is flagged (no model). */
@@ -38,10 +39,15 @@ int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, doubl
  * convex, holding the segment's points, over which `curv` bounds |g''|):
  * EXACT_FAST_NONE when g certainly has no root there; EXACT_FAST_ROOT with
  * *root when g is certified monotone on [a, b] with certified opposite
- * signs at the ends, and the double evaluation of g (tape_eval, as
- * exact_first_root) changes sign between *root and an adjacent double (the
- * end with the smaller |g|, the lower on a tie, as exact_refine; or a point
- * where it is 0); otherwise EXACT_FAST_UNDECIDED. */
+ * signs at the ends (so exactly one root t*), and *root lies in a certified
+ * enclosure of t* no wider than the noise band of g's double evaluation
+ * there (EXACT_FAST_BAND: four times its error bound over |g'|, and 4 ulps);
+ * otherwise EXACT_FAST_UNDECIDED. */
+/* The width of a root's enclosure that counts as converged: four times the
+ * value's error bound over |g'| (twice the noise band's width), plus 4 ulps
+ * of t. */
+#define EXACT_FAST_BAND(ev_over_dg, ulp) (4.0 * (ev_over_dg) + 4.0 * (ulp))
+
 int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                       double curv, const exact_model *model, double *root);
 

@@ -18,7 +18,8 @@ int exact_scratch_init(exact_scratch *w, uint32_t n)
     w->dslots = malloc(n * sizeof *w->dslots);
     w->idir = malloc(n * sizeof *w->idir);
     w->dir = malloc(n * sizeof *w->dir);
-    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir) {
+    w->edir = malloc(n * sizeof *w->edir);
+    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir || !w->edir) {
         exact_scratch_free(w);
         return -1;
     }
@@ -33,6 +34,8 @@ void exact_scratch_free(exact_scratch *w)
     free(w->dslots);
     free(w->idir);
     free(w->dir);
+    free(w->edir);
+    w->edir = NULL;
     w->idir = NULL;
     w->dir = NULL;
     w->slots = NULL;

@@ -9,6 +9,7 @@
 
 #include "common/expr/tape.h"
 #include "common/expr/tape_dir.h"
+#include "common/expr/tape_err.h"
 
 /* A line p(t) = o + t * d in the tape's (world) coordinates. */
 typedef struct exact_line {
@@ -24,6 +25,7 @@ typedef struct exact_scratch {
     tape_dual *dslots;
     tape_idir1 *idir; /* the fast path's (render/exact_fast.c) */
     tape_dir1 *dir;
+    tape_edir *edir;
 } exact_scratch;
 
 /* Allocates scratch for tapes of up to n instructions: 0, or -1 when out
