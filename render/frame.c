@@ -477,10 +477,10 @@ int frame_render(const frame_job *job, frame_stats *stats)
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     int rc = 0;
     if (job->aa > 1) {
-        sh.probes = calloc(npx, sizeof *sh.probes);
+        sh.probes = frame_probes_alloc(npx);
         sh.tile_any = calloc((size_t)sh.tiles_x * sh.tiles_y, 1);
         if (!sh.probes || !sh.tile_any) {
-            free(sh.probes);
+            frame_probes_free(sh.probes, npx);
             free(sh.tile_any);
             sh.probes = NULL;
             sh.tile_any = NULL;
@@ -493,7 +493,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
         if (!rc1)
             rc1 = rc2;
     }
-    free(sh.probes);
+    frame_probes_free(sh.probes, npx);
     free(sh.tile_any);
     exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);

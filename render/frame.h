@@ -38,6 +38,8 @@ typedef struct frame_job {
                            colour (straight alpha) and misses are black */
     int no_beam_edge;   /* 1: without the beam's edge trigger (aa.h), only the
                            neighbour test chooses the pixels to sample (tests) */
+    int no_packets;     /* 1: every antialiasing sample traced alone, not in
+                           packets (trace_packet.h; tests compare the two) */
     trace_traverse_fn traverse; /* NULL: the build's preferred implementation */
     int timing;         /* 1: time the secondary rays apart (frame_stats) */
     /* Called by the calling thread after each tile it finishes, with tiles

@@ -3,6 +3,7 @@
 #ifndef FRAME_IMPL_H
 #define FRAME_IMPL_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "render/frame.h"
@@ -44,6 +45,11 @@ uint8_t frame_srgb8_ready(float x);
 void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit *h,
                         const double dir[3], uint32_t i, uint32_t j, unsigned ao_k0,
                         unsigned ao_count, unsigned ao_total, float rgb[3], float n[3]);
+
+/* The probes of an image of n pixels, zeroed (NULL when they cannot be
+ * had), and their release (accepts NULL). */
+aa_probe *frame_probes_alloc(size_t n);
+void frame_probes_free(aa_probe *p, size_t n);
 
 /* The antialiasing pass over the pixels [i0, i1) x [j0, j1) of a tile:
  * samples where the edge test asks for them. any: the tile's centre rays

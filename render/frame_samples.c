@@ -1,11 +1,50 @@
 /* frame_samples: the antialiasing pass of a frame (RENDER.md,
  * "Antialiasing"): the pixels the edge test picks, traced again with
- * samples from their beam sub-block's start and anchor. */
+ * samples from their beam sub-block's start: as packets under the paper's
+ * rule (trace_packet.h), else one by one from the pixel's anchor. */
 #include "render/frame_impl.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <sys/mman.h>
 
 #include "render/beam.h"
+#include "render/trace_packet.h"
+
+/* A megapixel's probes are 24 MB, whose first touch in the centre pass
+ * took some 6 000 page faults (13 ms of system time at 1024^2,
+ * docs/perf-log.md): large ones are mapped asking for huge pages. */
+#define PROBES_MAPPED (UINT64_C(1) << 21)
+
+aa_probe *frame_probes_alloc(size_t n)
+{
+    const size_t bytes = n * sizeof(aa_probe);
+    if (n > SIZE_MAX / sizeof(aa_probe))
+        return NULL;
+#if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
+    if (bytes >= PROBES_MAPPED) {
+        void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (p == MAP_FAILED)
+            return NULL;
+        (void)madvise(p, bytes, MADV_HUGEPAGE); /* a hint: no huge pages is fine */
+        return p; /* zeroed */
+    }
+#endif
+    return calloc(n, sizeof(aa_probe));
+}
+
+void frame_probes_free(aa_probe *p, size_t n)
+{
+    if (!p)
+        return;
+#if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
+    if (n * sizeof(aa_probe) >= PROBES_MAPPED) {
+        munmap(p, n * sizeof(aa_probe));
+        return;
+    }
+#endif
+    free(p);
+}
 
 /* Where the samples of pixel (i, j) may start (+inf: they all miss): its
  * sub-block's start, since a sub-block's pyramid holds its pixels' whole
@@ -37,43 +76,64 @@ static void sample_anchor(const frame_shared *sh, const trace_eye *eye, uint32_t
     trace_anchor_find(sh->job->tree, lo, hi, an);
 }
 
-/* Sample k of pixel (i, j) (aa.h's order), traced from t_lo and shaded
- * with AO rays k * per .. of per * N^2; its colour in rgb, what the edge
- * test keeps of it in p. */
-static void trace_sample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye,
-                         const trace_anchor *an, uint32_t i, uint32_t j, unsigned k, double t_lo,
-                         unsigned per, float rgb[3], aa_probe *p)
+/* What the samples of one pixel share: where they start, and the anchor
+ * the ones traced one by one start from (found when first needed). */
+typedef struct pixel_samples {
+    const trace_eye *eye;
+    uint32_t i, j;
+    double t_lo;
+    int packets;       /* the paper's rule: samples walked as packets */
+    int anchor_found;
+    trace_anchor an;
+} pixel_samples;
+
+/* Samples ks[0..n) (n <= TRACE_PACKET_MAX) of the pixel (aa.h's order),
+ * traced from t_lo: their directions and hits. As one packet when they
+ * fit one (trace_packet.h: the same hits as traced alone), else one by
+ * one from the pixel's anchor. */
+static void trace_samples(const frame_shared *sh, pixel_samples *ps, const unsigned *ks,
+                          unsigned n, double (*dir)[3], trace_hit *hits)
 {
     const frame_job *job = sh->job;
     const camera *cam = job->cam;
     const unsigned na = job->aa;
     const double w = (double)cam->width, hh = (double)cam->height;
-    double fx, fy, dir[3];
-    aa_sample_offset(na, k, &fx, &fy);
-    const double u = (2.0 * ((double)i + fx) / w - 1.0) * cam->h * w / hh;
-    const double v = (1.0 - 2.0 * ((double)j + fy) / hh) * cam->h;
-    camera_ray_uv(cam, u, v, dir);
-    trace_ray r;
-    trace_hit h;
-    if (t_lo < INFINITY && trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY)) {
-        sh->traverse(job->tree, &job->opts, &r, an, &h);
-    } else {
-        h.hit = 0;
-        h.t = INFINITY;
-        h.steps = 0;
+    trace_ray r[TRACE_PACKET_MAX];
+    unsigned slot[TRACE_PACKET_MAX], m = 0;
+    for (unsigned q = 0; q < n; q++) {
+        double fx, fy;
+        aa_sample_offset(na, ks[q], &fx, &fy);
+        const double u = (2.0 * ((double)ps->i + fx) / w - 1.0) * cam->h * w / hh;
+        const double v = (1.0 - 2.0 * ((double)ps->j + fy) / hh) * cam->h;
+        camera_ray_uv(cam, u, v, dir[q]);
+        hits[q].hit = 0;
+        hits[q].t = INFINITY;
+        hits[q].steps = 0;
+        if (ps->t_lo < INFINITY && trace_setup_eye(ps->eye, dir[q], &r[m]) &&
+            trace_clip(&r[m], ps->t_lo, INFINITY))
+            slot[m++] = q;
     }
-    acc->rays++;
-    acc->steps += h.steps;
-    frame_shade_sample(sh, acc, &h, dir, i, j, k * per, per, per * na * na, rgb, p->n);
-    p->hit = (uint8_t)h.hit;
-    p->t = h.hit ? (float)h.t : INFINITY;
-    p->surface = shade_surface(job->tree, &h);
+    if (ps->packets && trace_packet_fits(r, m)) {
+        trace_hit ph[TRACE_PACKET_MAX];
+        trace_packet_first(job->tree, r, m, ph);
+        for (unsigned k = 0; k < m; k++)
+            hits[slot[k]] = ph[k];
+        return;
+    }
+    if (m && !ps->anchor_found) {
+        sample_anchor(sh, ps->eye, ps->i, ps->j, ps->t_lo, &ps->an);
+        ps->anchor_found = 1;
+    }
+    for (unsigned k = 0; k < m; k++)
+        sh->traverse(job->tree, &job->opts, &r[k], &ps->an, &hits[slot[k]]);
 }
 
 /* Pixel (i, j) again with samples (aa.h): the four corner samples of the
  * N x N grid first; when they and the centre ray all agree by the edge
  * rule, the pixel holds no edge and they are its colour; otherwise all
- * N x N. Colours averaged in linear light; AO rays shared out. */
+ * N x N. Each is shaded as a pixel is (AO rays k * per .. of per * N^2
+ * for sample k), in the order of k within each of the two sets; colours
+ * averaged in linear light. */
 static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
                         uint32_t j)
 {
@@ -82,33 +142,52 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     const unsigned na = job->aa, ns = na * na, ao = job->shade.ao_rays;
     const unsigned per = ao ? (ao / ns > 0 ? ao / ns : 1) : 0;
     const size_t px = (size_t)j * cam->width + i;
+    /* the corners, then the others, each set in increasing k */
+    unsigned order[AA_MAX * AA_MAX], no = 0;
     const unsigned corner[4] = {0, na - 1, ns - na, ns - 1};
+    for (unsigned c = 0; c < 4; c++)
+        order[no++] = corner[c];
+    for (unsigned k = 0; k < ns; k++)
+        if (k != corner[0] && k != corner[1] && k != corner[2] && k != corner[3])
+            order[no++] = k;
+    pixel_samples ps;
+    ps.eye = eye;
+    ps.i = i;
+    ps.j = j;
+    ps.t_lo = sample_start(sh, i, j);
+    ps.packets = !job->exact && !job->opts.refine && !job->no_packets;
+    ps.anchor_found = 0;
     float sum[3] = {0.0f, 0.0f, 0.0f};
     unsigned hits = 0, done = 0;
     int uniform = 1;
-    const double t_lo = sample_start(sh, i, j);
-    trace_anchor an;
-    sample_anchor(sh, eye, i, j, t_lo, &an);
-    for (unsigned k = 0; k < ns; k++) {
-        int is_corner = 0;
-        for (unsigned c = 0; c < 4; c++)
-            is_corner |= k == corner[c];
-        const int pass = done < 4 ? 0 : 1; /* corners, then the rest */
-        if (pass == 0 ? !is_corner : is_corner)
-            continue;
-        float rgb[3];
-        aa_probe p;
-        trace_sample(sh, acc, eye, &an, i, j, k, t_lo, per, rgb, &p);
-        uniform &= !aa_differs(&p, &sh->probes[px]);
-        hits += p.hit;
-        if (p.hit || !job->alpha)
-            for (int a = 0; a < 3; a++)
-                sum[a] += rgb[a];
-        if (++done == 4) {
-            if (uniform)
-                break;
-            k = (unsigned)-1; /* the rest, from the start */
+    while (done < ns) {
+        const unsigned end = done < 4 ? 4 : ns; /* the corners, then the rest */
+        for (unsigned q0 = done; q0 < end; q0 += TRACE_PACKET_MAX) {
+            const unsigned n = end - q0 < TRACE_PACKET_MAX ? end - q0 : TRACE_PACKET_MAX;
+            double dir[TRACE_PACKET_MAX][3];
+            trace_hit h[TRACE_PACKET_MAX];
+            trace_samples(sh, &ps, order + q0, n, dir, h);
+            for (unsigned q = 0; q < n; q++) {
+                const unsigned k = order[q0 + q];
+                float rgb[3];
+                aa_probe p;
+                acc->rays++;
+                acc->steps += h[q].steps;
+                frame_shade_sample(sh, acc, &h[q], dir[q], i, j, k * per, per, per * ns, rgb,
+                                   p.n);
+                p.hit = (uint8_t)h[q].hit;
+                p.t = h[q].hit ? (float)h[q].t : INFINITY;
+                p.surface = shade_surface(job->tree, &h[q]);
+                uniform &= !aa_differs(&p, &sh->probes[px]);
+                hits += p.hit;
+                if (p.hit || !job->alpha)
+                    for (int a = 0; a < 3; a++)
+                        sum[a] += rgb[a];
+            }
         }
+        done = end;
+        if (done == 4 && uniform)
+            break;
     }
     const float div = job->alpha ? (float)(hits ? hits : 1) : (float)done;
     for (int a = 0; a < 3; a++)

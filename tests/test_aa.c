@@ -4,7 +4,8 @@
  * averaged in linear light; depth kept from the centre ray; the image the
  * same whatever the thread count and traversal implementation; the beam's
  * edge trigger finds what lies between centre rays; samples started at
- * their sub-block's start are those traced whole. */
+ * their sub-block's start are those traced whole; samples walked as
+ * packets are those traced one by one. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -357,6 +358,70 @@ static void test_sample_starts_exact(void **state)
     tree_util_free(s.tree);
 }
 
+/* The samples walked as packets (the default, paper's rule) and traced
+ * one by one give the same image, byte for byte: every N, with shadows,
+ * AO and alpha, on a sphere and on a cloud of single voxels (sub-pixel
+ * details, rays grazing small cells), from several threads. */
+static void test_packets_same_image(void **state)
+{
+    (void)state;
+    scene sp = sphere_scene(8, 70.0, 260.0, 45.0);
+    uint32_t(*xyz)[3] = malloc(3000 * sizeof *xyz);
+    assert_non_null(xyz);
+    uint64_t seed = 0x5eed;
+    const size_t m = tree_util_distinct_voxels(3000, 40, 48, &seed, xyz);
+    oct_tree *cloud = tree_util_simple(7, (const uint32_t(*)[3])xyz, m);
+    assert_non_null(cloud);
+    const oct_tree *trees[2] = {sp.tree, cloud};
+    const size_t np = W * H;
+    uint8_t *rgb = malloc(np * 3), *ref = malloc(np * 3), *alpha = malloc(np), *aref = malloc(np);
+    assert_true(rgb && ref && alpha && aref);
+    camera cc;
+    const double eye[3] = {1.3, -0.4, 1.1}, target[3] = {0.5, 0.5, 0.5}, up[3] = {0, 0, 1};
+    assert_int_equal(camera_init(&cc, eye, target, up, 30.0, W, H), CAMERA_OK);
+    const camera *cams[2] = {&sp.cam, &cc};
+    unsigned long sampled = 0;
+    for (int sc = 0; sc < 2; sc++)
+        for (unsigned aa = 2; aa <= 5; aa++) {
+            frame_job job;
+            memset(&job, 0, sizeof job);
+            job.tree = trees[sc];
+            job.cam = cams[sc];
+            job.opts.split = trees[sc]->levels;
+            job.shade.ambient = 0.2f;
+            job.shade.shadows = aa % 2;
+            job.shade.ao_rays = aa == 4 ? 8 : 0;
+            shade_default_light(cams[sc], job.shade.light);
+            job.beam_size = FRAME_BEAM_DEFAULT;
+            job.aa = aa;
+            frame_stats st, st0;
+            job.threads = 1;
+            job.no_packets = 1;
+            job.rgb = ref;
+            job.alpha = aa == 3 ? NULL : aref;
+            assert_int_equal(frame_render(&job, &st0), 0);
+            job.threads = 3;
+            job.no_packets = 0;
+            job.rgb = rgb;
+            job.alpha = aa == 3 ? NULL : alpha;
+            assert_int_equal(frame_render(&job, &st), 0);
+            assert_memory_equal(rgb, ref, np * 3);
+            if (aa != 3)
+                assert_memory_equal(alpha, aref, np);
+            assert_true(st.rays == st0.rays && st.aa_full == st0.aa_full);
+            sampled += st.aa_pixels;
+        }
+    print_message("packets: %lu pixels sampled, the same bytes as ray by ray\n", sampled);
+    assert_true(sampled > 400);
+    free(rgb);
+    free(ref);
+    free(alpha);
+    free(aref);
+    free(xyz);
+    tree_util_free(cloud);
+    tree_util_free(sp.tree);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -366,6 +431,7 @@ int main(void)
         cmocka_unit_test(test_linear_average),
         cmocka_unit_test(test_beam_edge_trigger),
         cmocka_unit_test(test_sample_starts_exact),
+        cmocka_unit_test(test_packets_same_image),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
