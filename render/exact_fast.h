@@ -14,7 +14,8 @@
 enum {
     EXACT_FAST_UNDECIDED = 0, /* use exact_first_root */
     EXACT_FAST_NONE = 1,      /* certified: no root of f on the span */
-    EXACT_FAST_ROOT = 2,      /* the root, converged to adjacent doubles */
+    EXACT_FAST_ROOT = 2,      /* the root, within a certified enclosure no wider
+                                 than twice the noise band (EXACT_FAST_BAND) */
 };
 
 /* The bound on |g''(t)| = |d^T Hess f d| along the line's direction d from

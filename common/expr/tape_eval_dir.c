@@ -13,41 +13,45 @@ double tape_eval_dir(const tape *t, const double p[3], const double d[3], double
     const tape_const *k = t->konst;
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_dir1 *r = &s[i];
-        const tape_dir1 a = s[slot_a(&in[i])], c = s[slot_b(&in[i])];
+        /* operands: only the ops that have them name them (as tape_eval) */
+#define OA s[in[i].a]
+#define OC s[in[i].b]
         switch ((tape_op)in[i].op) {
         case TAPE_CONST: r->v = k[in[i].a].v; r->d = 0.0; break;
         case TAPE_X: case TAPE_Y: case TAPE_Z:
             r->v = p[in[i].op - TAPE_X];
             r->d = d[in[i].op - TAPE_X];
             break;
-        case TAPE_NEG: r->v = -a.v; r->d = -a.d; break;
-        case TAPE_SQUARE: r->v = a.v * a.v; r->d = a.d * (2.0 * a.v); break;
-        case TAPE_SQRT: r->v = sqrt(a.v); r->d = a.d * (0.5 / r->v); break;
-        case TAPE_EXP: r->v = exp(a.v); r->d = a.d * r->v; break;
-        case TAPE_LOG: r->v = log(a.v); r->d = a.d * (1.0 / a.v); break;
-        case TAPE_ABS: r->v = fabs(a.v); r->d = a.v < 0.0 ? -a.d : a.d; break;
-        case TAPE_SIN: { double sv, cv; point_sincos(a.v, &sv, &cv); r->v = sv; r->d = a.d * cv; break; }
-        case TAPE_COS: { double sv, cv; point_sincos(a.v, &sv, &cv); r->v = cv; r->d = a.d * -sv; break; }
-        case TAPE_TAN: r->v = tan(a.v); r->d = a.d * (1.0 + r->v * r->v); break;
-        case TAPE_ADD: r->v = a.v + c.v; r->d = a.d + c.d; break;
-        case TAPE_SUB: r->v = a.v - c.v; r->d = a.d - c.d; break;
-        case TAPE_MUL: r->v = a.v * c.v; r->d = a.d * c.v + a.v * c.d; break;
-        case TAPE_DIV: r->v = a.v / c.v; r->d = (a.d - r->v * c.d) / c.v; break;
+        case TAPE_NEG: r->v = -OA.v; r->d = -OA.d; break;
+        case TAPE_SQUARE: r->v = OA.v * OA.v; r->d = OA.d * (2.0 * OA.v); break;
+        case TAPE_SQRT: r->v = sqrt(OA.v); r->d = OA.d * (0.5 / r->v); break;
+        case TAPE_EXP: r->v = exp(OA.v); r->d = OA.d * r->v; break;
+        case TAPE_LOG: r->v = log(OA.v); r->d = OA.d * (1.0 / OA.v); break;
+        case TAPE_ABS: r->v = fabs(OA.v); r->d = OA.v < 0.0 ? -OA.d : OA.d; break;
+        case TAPE_SIN: { double sv, cv; point_sincos(OA.v, &sv, &cv); r->v = sv; r->d = OA.d * cv; break; }
+        case TAPE_COS: { double sv, cv; point_sincos(OA.v, &sv, &cv); r->v = cv; r->d = OA.d * -sv; break; }
+        case TAPE_TAN: r->v = tan(OA.v); r->d = OA.d * (1.0 + r->v * r->v); break;
+        case TAPE_ADD: r->v = OA.v + OC.v; r->d = OA.d + OC.d; break;
+        case TAPE_SUB: r->v = OA.v - OC.v; r->d = OA.d - OC.d; break;
+        case TAPE_MUL: r->v = OA.v * OC.v; r->d = OA.d * OC.v + OA.v * OC.d; break;
+        case TAPE_DIV: r->v = OA.v / OC.v; r->d = (OA.d - r->v * OC.d) / OC.v; break;
         case TAPE_MIN:
         case TAPE_MAX: {
-            const double v = in[i].op == TAPE_MIN ? point_min(a.v, c.v) : point_max(a.v, c.v);
-            r->d = (v == a.v || v != v) ? a.d : c.d;
+            const double v = in[i].op == TAPE_MIN ? point_min(OA.v, OC.v) : point_max(OA.v, OC.v);
+            r->d = (v == OA.v || v != v) ? OA.d : OC.d;
             r->v = v;
             break;
         }
         case TAPE_POWC: {
             const double e = k[in[i].b].v;
-            r->v = pow(a.v, e);
-            r->d = a.d * (e * pow(a.v, e - 1.0));
+            r->v = pow(OA.v, e);
+            r->d = OA.d * (e * pow(OA.v, e - 1.0));
             break;
         }
         case TAPE_NOPS: r->v = NAN; r->d = NAN; break;
         }
+#undef OA
+#undef OC
     }
     *deriv = s[t->root].d;
     return s[t->root].v;

@@ -57,7 +57,9 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
     const tape_const *k = t->konst;
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_edir *r = &s[i];
-        const tape_edir *a = &s[slot_a(&in[i])], *c = &s[slot_b(&in[i])];
+        /* operands: only the ops that have them name them (as tape_eval) */
+#define OA (&s[in[i].a])
+#define OC (&s[in[i].b])
         int ok = 1;
         switch ((tape_op)in[i].op) {
         case TAPE_CONST: {
@@ -78,56 +80,56 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             ok = small(r->v) & small(r->d);
             break;
         case TAPE_NEG:
-            r->v = -a->v;
-            r->ev = a->ev;
-            r->d = -a->d;
-            r->ed = a->ed;
+            r->v = -OA->v;
+            r->ev = OA->ev;
+            r->d = -OA->d;
+            r->ed = OA->ed;
             break;
         case TAPE_SQUARE:
             /* |â² - a²| <= ea (2|â| + ea) */
-            r->v = a->v * a->v;
-            r->ev = fin(a->ev * (2.0 * fabs(a->v) + a->ev) + U * r->v);
-            scaled(r, a, 2.0 * a->v, 2.0 * a->ev);
+            r->v = OA->v * OA->v;
+            r->ev = fin(OA->ev * (2.0 * fabs(OA->v) + OA->ev) + U * r->v);
+            scaled(r, OA, 2.0 * OA->v, 2.0 * OA->ev);
             break;
         case TAPE_SQRT: {
             /* a >= â - ea >= SMALL; |√â - √a| <= ea / √â */
-            if (!(a->v - a->ev >= SMALL))
+            if (!(OA->v - OA->ev >= SMALL))
                 return 0;
-            r->v = sqrt(a->v);
-            r->ev = fin(U * r->v + a->ev / r->v);
+            r->v = sqrt(OA->v);
+            r->ev = fin(U * r->v + OA->ev / r->v);
             /* √a >= v - ev = ls; |0.5/v - 0.5/√a| <= 0.5 ev / (v ls) */
             const double ls = r->v - r->ev, sc = 0.5 / r->v;
             if (!(ls >= SMALL))
                 return 0;
-            scaled(r, a, sc, fin(U * sc + 0.5 * r->ev / (r->v * ls)));
+            scaled(r, OA, sc, fin(U * sc + 0.5 * r->ev / (r->v * ls)));
             break;
         }
         case TAPE_EXP:
             /* |exp(â) - exp(a)| <= exp(â) (e^ea - 1) <= exp(â) ea (1 + ea) */
-            if (!(a->ev <= 0.0625 && a->v <= 69.0)) /* (e^69 < BIG: no overflow) */
+            if (!(OA->ev <= 0.0625 && OA->v <= 69.0)) /* (e^69 < BIG: no overflow) */
                 return 0;
-            r->v = exp(a->v);
-            r->ev = fin(LIB * r->v + r->v * (1.0 + LIB) * a->ev * (1.0 + a->ev));
-            scaled(r, a, r->v, r->ev);
+            r->v = exp(OA->v);
+            r->ev = fin(LIB * r->v + r->v * (1.0 + LIB) * OA->ev * (1.0 + OA->ev));
+            scaled(r, OA, r->v, r->ev);
             break;
         case TAPE_LOG: {
             /* a >= l = â - ea >= SMALL: |log â - log a| <= ea / l,
              * |1/â - 1/a| <= ea / (â l) */
-            const double l = a->v - a->ev;
+            const double l = OA->v - OA->ev;
             if (!(l >= SMALL))
                 return 0;
-            r->v = log(a->v);
-            r->ev = fin(LIB * fabs(r->v) + a->ev / l);
-            const double sc = 1.0 / a->v;
-            scaled(r, a, sc, fin(U * sc + a->ev / (a->v * l)));
+            r->v = log(OA->v);
+            r->ev = fin(LIB * fabs(r->v) + OA->ev / l);
+            const double sc = 1.0 / OA->v;
+            scaled(r, OA, sc, fin(U * sc + OA->ev / (OA->v * l)));
             break;
         }
         case TAPE_ABS:
-            ok = fabs(a->v) > a->ev; /* a has â's sign: no kink within reach */
-            r->v = fabs(a->v);
-            r->ev = a->ev;
-            r->d = a->v < 0.0 ? -a->d : a->d;
-            r->ed = a->ed;
+            ok = fabs(OA->v) > OA->ev; /* a has â's sign: no kink within reach */
+            r->v = fabs(OA->v);
+            r->ev = OA->ev;
+            r->d = OA->v < 0.0 ? -OA->d : OA->d;
+            r->ed = OA->ed;
             break;
         case TAPE_SIN:
         case TAPE_COS: {
@@ -135,20 +137,20 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
              * ea²/2, |cos â - cos a| <= |sin â| ea + ea²/2 (|cos â| <= |cv|
              * (1 + LIB): cv is libm's) */
             double sv, cv;
-            if (!(fabs(a->v) <= TRIG_MAX))
+            if (!(fabs(OA->v) <= TRIG_MAX))
                 return 0;
-            point_sincos(a->v, &sv, &cv);
-            const double q = 0.5 * a->ev * a->ev, ea = (1.0 + LIB) * a->ev;
+            point_sincos(OA->v, &sv, &cv);
+            const double q = 0.5 * OA->ev * OA->ev, ea = (1.0 + LIB) * OA->ev;
             const double bs = fin(LIB * fabs(sv) + fabs(cv) * ea + q);
             const double bc = fin(LIB * fabs(cv) + fabs(sv) * ea + q);
             if (in[i].op == TAPE_SIN) {
                 r->v = sv;
                 r->ev = bs;
-                scaled(r, a, cv, bc);
+                scaled(r, OA, cv, bc);
             } else {
                 r->v = cv;
                 r->ev = bc;
-                scaled(r, a, -sv, bs);
+                scaled(r, OA, -sv, bs);
             }
             break;
         }
@@ -157,93 +159,98 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
              * T tau <= 1/4, for |x - â| <= ea: tan x = (tan â + tan δ) /
              * (1 - tan â tan δ), |δ| <= ea, so no pole and |tan x| <= M =
              * (T + tau) / (1 - T tau), |tan' x| <= 1 + M² */
-            if (!(fabs(a->v) <= TRIG_MAX && a->ev <= 0.0625))
+            if (!(fabs(OA->v) <= TRIG_MAX && OA->ev <= 0.0625))
                 return 0;
-            r->v = tan(a->v);
-            const double T = fabs(r->v) * (1.0 + LIB), tau = 1.01 * a->ev;
+            r->v = tan(OA->v);
+            const double T = fabs(r->v) * (1.0 + LIB), tau = 1.01 * OA->ev;
             if (!(T * tau <= 0.25 && small(T)))
                 return 0;
             const double M = (T + tau) / (1.0 - T * tau);
-            r->ev = fin(LIB * fabs(r->v) + (1.0 + M * M) * a->ev);
+            r->ev = fin(LIB * fabs(r->v) + (1.0 + M * M) * OA->ev);
             const double t2 = r->v * r->v, sc = 1.0 + t2;
             const double es = fin(r->ev * (2.0 * fabs(r->v) + r->ev) + U * t2 + U * sc);
             if (!(small(sc) & small(es)))
                 return 0;
-            scaled(r, a, sc, es);
+            scaled(r, OA, sc, es);
             break;
         }
         case TAPE_ADD:
-        case TAPE_SUB: {
-            const int add = in[i].op == TAPE_ADD;
-            r->v = add ? a->v + c->v : a->v - c->v;
-            r->ev = fin(a->ev + c->ev + U * fabs(r->v));
-            r->d = add ? a->d + c->d : a->d - c->d;
-            r->ed = fin(a->ed + c->ed + U * fabs(r->d));
+            r->v = OA->v + OC->v;
+            r->d = OA->d + OC->d;
+            r->ev = fin(OA->ev + OC->ev + U * fabs(r->v));
+            r->ed = fin(OA->ed + OC->ed + U * fabs(r->d));
             break;
-        }
+        case TAPE_SUB:
+            r->v = OA->v - OC->v;
+            r->d = OA->d - OC->d;
+            r->ev = fin(OA->ev + OC->ev + U * fabs(r->v));
+            r->ed = fin(OA->ed + OC->ed + U * fabs(r->d));
+            break;
         case TAPE_MUL: {
-            r->v = a->v * c->v;
-            r->ev = fin(fabs(a->v) * c->ev + fabs(c->v) * a->ev + a->ev * c->ev + U * fabs(r->v));
-            const double p1 = a->d * c->v, p2 = a->v * c->d;
+            r->v = OA->v * OC->v;
+            r->ev = fin(fabs(OA->v) * OC->ev + fabs(OC->v) * OA->ev + OA->ev * OC->ev + U * fabs(r->v));
+            const double p1 = OA->d * OC->v, p2 = OA->v * OC->d;
             r->d = p1 + p2;
-            r->ed = fin(fabs(a->d) * c->ev + fabs(c->v) * a->ed + a->ed * c->ev +
-                        fabs(a->v) * c->ed + fabs(c->d) * a->ev + a->ev * c->ed +
+            r->ed = fin(fabs(OA->d) * OC->ev + fabs(OC->v) * OA->ed + OA->ed * OC->ev +
+                        fabs(OA->v) * OC->ed + fabs(OC->d) * OA->ev + OA->ev * OC->ed +
                         U * (fabs(p1) + fabs(p2) + fabs(r->d)));
             break;
         }
         case TAPE_DIV: {
             /* |c| >= l = |ĉ| - ec >= SMALL; â/ĉ - a/c = (â - a)/c + (â/ĉ)(c - ĉ)/c */
-            const double l = fabs(c->v) - c->ev;
+            const double l = fabs(OC->v) - OC->ev;
             if (!(l >= SMALL))
                 return 0;
-            r->v = a->v / c->v;
-            r->ev = fin(U * fabs(r->v) + (a->ev + fabs(r->v) * c->ev) / l);
+            r->v = OA->v / OC->v;
+            r->ev = fin(U * fabs(r->v) + (OA->ev + fabs(r->v) * OC->ev) / l);
             /* d = (a' - v c') / c: the numerator's error en, then as above */
-            const double q = r->v * c->d, nu = a->d - q;
-            r->d = nu / c->v;
-            const double en = a->ed + fabs(r->v) * c->ed + fabs(c->d) * r->ev + r->ev * c->ed +
+            const double q = r->v * OC->d, nu = OA->d - q;
+            r->d = nu / OC->v;
+            const double en = OA->ed + fabs(r->v) * OC->ed + fabs(OC->d) * r->ev + r->ev * OC->ed +
                               U * (fabs(q) + fabs(nu));
-            r->ed = fin(U * fabs(r->d) + (en + fabs(r->d) * c->ev) / l);
+            r->ed = fin(U * fabs(r->d) + (en + fabs(r->d) * OC->ev) / l);
             break;
         }
         case TAPE_MIN:
         case TAPE_MAX: {
             /* operands further apart than their errors: the exact values
              * take the same branch, and no kink is within reach */
-            ok = fabs(a->v - c->v) > (a->ev + c->ev) * C;
-            const double v = in[i].op == TAPE_MIN ? point_min(a->v, c->v) : point_max(a->v, c->v);
-            *r = v == a->v ? *a : *c;
+            ok = fabs(OA->v - OC->v) > (OA->ev + OC->ev) * C;
+            const double v = in[i].op == TAPE_MIN ? point_min(OA->v, OC->v) : point_max(OA->v, OC->v);
+            *r = v == OA->v ? *OA : *OC;
             break;
         }
         case TAPE_POWC: {
             /* a >= â - ea >= SMALL, rho = ea/â <= 1/2: for x between a and â,
              * (x/â)^(p-1) <= exp(2 rho |p-1|) <= 1 + 4 rho |p-1| when
              * 2 rho |p-1| <= 1; so |â^p - a^p| <= |p| (â^p / â)(1 + 4 rho |p-1|) ea */
-            if (!(a->v - a->ev >= SMALL))
+            if (!(OA->v - OA->ev >= SMALL))
                 return 0;
-            const double e = k[in[i].b].v, e1 = e - 1.0, rho = a->ev / a->v;
+            const double e = k[in[i].b].v, e1 = e - 1.0, rho = OA->ev / OA->v;
             if (!(rho <= 0.5 && 2.0 * rho * fabs(e1) <= 1.0 &&
                   2.0 * rho * fabs(e - 2.0) <= 1.0))
                 return 0;
-            r->v = pow(a->v, e);
-            const double q = pow(a->v, e1);
+            r->v = pow(OA->v, e);
+            const double q = pow(OA->v, e1);
             if (!(small(r->v) & small(q)))
                 return 0;
-            r->ev = fin(LIB * r->v + fabs(e) * (r->v / a->v) * (1.0 + 4.0 * rho * fabs(e1)) * a->ev);
+            r->ev = fin(LIB * r->v + fabs(e) * (r->v / OA->v) * (1.0 + 4.0 * rho * fabs(e1)) * OA->ev);
             /* the scale e a^(e-1): e1 is e - 1 + r (r exact by two-sum), worth
              * a factor â^r within 140 |r| of 1 (|log â| <= 70, |r| <= u |e1|) */
             const double bb = e1 - e, r1 = (e - (e1 - bb)) + (-1.0 - bb);
             const double eq = LIB * q + 140.0 * fabs(r1) * q +
-                              fabs(e1) * (q / a->v) * (1.0 + 4.0 * rho * fabs(e - 2.0)) * a->ev;
+                              fabs(e1) * (q / OA->v) * (1.0 + 4.0 * rho * fabs(e - 2.0)) * OA->ev;
             const double sc = e * q;
             const double es = fin(fabs(e) * eq + U * fabs(sc));
             if (!(small(sc) & small(es)))
                 return 0;
-            scaled(r, a, sc, es);
+            scaled(r, OA, sc, es);
             break;
         }
         case TAPE_NOPS: ok = 0; break;
         }
+#undef OA
+#undef OC
         if (!(ok & bounded(r->ev, r->ed)))
             return 0;
     }
