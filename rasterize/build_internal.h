@@ -195,13 +195,14 @@ void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *
                       uint8_t *drop);
 
 /* The mean-value enclosures of the eight children of the node (depth, cell)
- * with box pbox, into out, the form centred on fcc. Without reuse, G and fc
+ * with box pbox, the form centred on fcc: bit i of *fx set when child i's
+ * excludes 0. Without reuse, G and fc
  * receive the gradient enclosure over the node and f's enclosure at fcc, the
  * node's centre; with reuse they hold those of a box holding the node (its
  * parent's), centred on fcc. 0 when unavailable. */
 int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned depth,
                      const uint64_t cell[3], const double fcc[3], interval *fc, interval G[3],
-                     int reuse, interval out[8]);
+                     int reuse, uint8_t *fx);
 
 /* --- voxels (voxel_normal.c) -------------------------------------------- */
 

@@ -71,13 +71,14 @@ static inline void child_boxes_init(const build_ctx *c, unsigned depth, const ui
 static inline int child_box(child_boxes *cb, unsigned i)
 {
     if (cb->have[i] < 0) {
-        unsigned b[3] = {i & 1, (i >> 1) & 1, i >> 2};
-        cb->have[i] = 1;
-        for (int k = 0; k < 3; k++) {
-            cb->have[i] &= cb->half_ok[k][b[k]];
-            cb->box[i][k] = cb->half[k][b[k]];
-            cb->centre[i][k] = cb->mid[k][b[k]];
-        }
+        const unsigned bx = i & 1, by = (i >> 1) & 1, bz = i >> 2;
+        cb->have[i] = (int8_t)(cb->half_ok[0][bx] & cb->half_ok[1][by] & cb->half_ok[2][bz]);
+        cb->box[i][0] = cb->half[0][bx];
+        cb->box[i][1] = cb->half[1][by];
+        cb->box[i][2] = cb->half[2][bz];
+        cb->centre[i][0] = cb->mid[0][bx];
+        cb->centre[i][1] = cb->mid[1][by];
+        cb->centre[i][2] = cb->mid[2][bz];
     }
     return cb->have[i];
 }

@@ -255,25 +255,114 @@ unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const ui
     return n;
 }
 
+/* The enclosures fc + x-half + y-half + z-half of the eight children (half
+ * the products of G with the offsets off), summed in that order; children
+ * that share the first terms share their partial sums (2 + 4 + 8 additions
+ * instead of 3 x 8, the same values). First with the operations' fast
+ * paths, without branches (interval_lanes.h); where one does not apply, all
+ * again with the operations themselves. Bit i of *fx set when child i's
+ * enclosure excludes 0; 0 when a flag was raised. */
+static int form_drops_exact(const interval *fc, const interval G[3], interval off[3][2],
+                            uint8_t *fx)
+{
+    interval half[3][2], s1[2], s2[4], out[8];
+    unsigned fl = 0;
+    uint64_t good = 1;
+    for (int k = 0; k < 3; k++)
+        for (int b = 0; b < 2; b++)
+            half[k][b] = il_mul(G[k], off[k][b], &good);
+    for (unsigned i = 0; i < 2; i++)
+        s1[i] = il_add(*fc, half[0][i], &good);
+    for (unsigned i = 0; i < 4; i++)
+        s2[i] = il_add(s1[i & 1], half[1][i >> 1], &good);
+    for (unsigned i = 0; i < 8; i++)
+        out[i] = il_add(s2[i & 3], half[2][i >> 2], &good);
+    if (!good) {
+        for (int k = 0; k < 3; k++)
+            for (int b = 0; b < 2; b++)
+                half[k][b] = interval_mul(G[k], off[k][b], &fl);
+        for (unsigned i = 0; i < 2; i++)
+            s1[i] = interval_add(*fc, half[0][i], &fl);
+        for (unsigned i = 0; i < 4; i++)
+            s2[i] = interval_add(s1[i & 1], half[1][i >> 1], &fl);
+        for (unsigned i = 0; i < 8; i++)
+            out[i] = interval_add(s2[i & 3], half[2][i >> 2], &fl);
+    }
+    *fx = 0;
+    for (unsigned i = 0; i < 8; i++)
+        *fx |= (uint8_t)((out[i].lo > 0.0 || out[i].hi < 0.0) << i);
+    return !fl; /* the fast paths raise no flag */
+}
+
+/* form_drops_exact's decisions without its enclosures: the same sums in
+ * plain double. Rounded outward, those enclosures lie within a few ulps of
+ * the magnitude of their terms from the exact sums of the exact products,
+ * as these do; so where a sum's end clears 0 by far more than that (the
+ * margin, and beyond flushed subnormals) the two agree on which side of 0
+ * it lies. 0 (undecided) where an end is nearer 0, or a term is not
+ * finite: then the caller runs form_drops_exact. */
+static void form_product(interval g, interval off, double *lo, double *hi)
+{
+    double p1 = g.lo * off.lo, p2 = g.lo * off.hi, p3 = g.hi * off.lo, p4 = g.hi * off.hi;
+    *lo = min2(min2(p1, p2), min2(p3, p4));
+    *hi = max2(max2(p1, p2), max2(p3, p4));
+}
+
+/* The decisions from the products' ends (plo, phi) and the magnitude of all
+ * the terms (mag). */
+static int form_decide(interval fc, double plo[3][2], double phi[3][2], double mag, uint8_t *fx)
+{
+    if (!(mag < INFINITY)) /* also NaN */
+        return 0;
+    const double margin = 0x1p-44 * mag + 0x1p-1000;
+    uint8_t m = 0;
+    for (unsigned i = 0; i < 8; i++) {
+        const unsigned bx = i & 1, by = (i >> 1) & 1, bz = i >> 2;
+        double lo = fc.lo + plo[0][bx] + plo[1][by] + plo[2][bz];
+        double hi = fc.hi + phi[0][bx] + phi[1][by] + phi[2][bz];
+        if (lo > margin || hi < -margin)
+            m |= (uint8_t)(1u << i);
+        else if (!(lo <= -margin && hi >= margin))
+            return 0;
+    }
+    *fx = m;
+    return 1;
+}
+
+static int form_drops_quick(const interval *fc, const interval G[3], interval off[3][2],
+                            uint8_t *fx)
+{
+    double plo[3][2], phi[3][2], mag = fabs(fc->lo) + fabs(fc->hi);
+    for (int k = 0; k < 3; k++)
+        for (int b = 0; b < 2; b++) {
+            form_product(G[k], off[k][b], &plo[k][b], &phi[k][b]);
+            mag += fabs(plo[k][b]) + fabs(phi[k][b]);
+        }
+    return form_decide(*fc, plo, phi, mag, fx);
+}
+
 /* The mean-value enclosures of a node's eight children. With c the form's
  * centre, fc an enclosure of f(c) and G one of the gradient over a box that
  * holds c and the node, every point p of child i satisfies f(p) in
  * fc + sum_k G_k (p_k - c_k), and p_k - c_k lies in the lower or upper
  * half-offset of axis k according to bit k of i. A leaf-parent takes its
  * parent's form (reuse): offsets up to twice as long make it wider by about
- * the width of G times a voxel, a percent or two of it, for no evaluation. The six products are formed once, so a child costs three
- * interval additions and no tape evaluation. The form's excess width shrinks
- * with the square of the cell size, so on the finest levels it is tighter
- * than the plain interval as well as cheaper. Returns 0 when G or f(c) may be
- * undefined (then the caller tests the children one by one). */
+ * the width of G times a voxel, a percent or two of it, for no evaluation.
+ * The six products are formed once, so a child costs three additions and no
+ * tape evaluation. The form's excess width shrinks with the square of the
+ * cell size, so on the finest levels it is tighter than the plain interval
+ * as well as cheaper. Only whether each enclosure excludes 0 is kept (bit i
+ * of *fx), decided in plain double where that is certain. Returns 0 when G
+ * or f(c) may be undefined (then the caller tests the children one by
+ * one). */
 int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned depth,
                      const uint64_t cell[3], const double fcc[3], interval *fc, interval G[3],
-                     int reuse, interval out[8])
+                     int reuse, uint8_t *fx)
 {
     const build_ctx *c = wk->c;
-    interval half[3][2], off[3][2];
-    unsigned fl = 0;
+    interval off[3][2];
     if (!reuse) {
+        unsigned fl = 0;
         tape_eval_interval_grad(t, pbox, G, wk->islots, &fl);
         wk->st.gradient_evals++;
         if (fl || !eval_at_centre(wk, t, fcc, fc))
@@ -288,32 +377,5 @@ int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned
         off[k][0] = lo;
         off[k][1] = hi;
     }
-    /* fc + x-half, + y-half, + z-half, summed in that order for every
-     * child; children that share the first terms share their partial sums
-     * (2 + 4 + 8 additions instead of 3 x 8, the same values). First with
-     * the operations' fast paths, without branches (interval_lanes.h); where
-     * one does not apply, all again with the operations themselves. */
-    interval s1[2], s2[4];
-    uint64_t good = 1;
-    for (int k = 0; k < 3; k++)
-        for (int b = 0; b < 2; b++)
-            half[k][b] = il_mul(G[k], off[k][b], &good);
-    for (unsigned i = 0; i < 2; i++)
-        s1[i] = il_add(*fc, half[0][i], &good);
-    for (unsigned i = 0; i < 4; i++)
-        s2[i] = il_add(s1[i & 1], half[1][i >> 1], &good);
-    for (unsigned i = 0; i < 8; i++)
-        out[i] = il_add(s2[i & 3], half[2][i >> 2], &good);
-    if (good)
-        return 1; /* no flag: fl is 0 here, and the fast paths raise none */
-    for (int k = 0; k < 3; k++)
-        for (int b = 0; b < 2; b++)
-            half[k][b] = interval_mul(G[k], off[k][b], &fl);
-    for (unsigned i = 0; i < 2; i++)
-        s1[i] = interval_add(*fc, half[0][i], &fl);
-    for (unsigned i = 0; i < 4; i++)
-        s2[i] = interval_add(s1[i & 1], half[1][i >> 1], &fl);
-    for (unsigned i = 0; i < 8; i++)
-        out[i] = interval_add(s2[i & 3], half[2][i >> 2], &fl);
-    return !fl;
+    return form_drops_quick(fc, G, off, fx) || form_drops_exact(fc, G, off, fx);
 }

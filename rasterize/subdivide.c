@@ -49,7 +49,7 @@ static int skip_centre(const worker *wk, interval fc, const interval G[3], const
 /* For a leaf-parent: f and its gradient at the centres of the children that
  * the mean-value form leaves to the centred re-test, surface by surface, one
  * pass over the tape for all of them (tape_eval_grad_lanes), into wk->cf8. */
-static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *fx,
                          child_boxes *cb)
 {
     const build_ctx *c = wk->c;
@@ -61,7 +61,7 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
             continue;
         double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
         for (unsigned i = 0; i < 8; i++) {
-            if (T[k][i].lo > 0.0 || T[k][i].hi < 0.0 || !child_box(cb, i))
+            if ((fx[k] >> i) & 1 || !child_box(cb, i))
                 continue;
             x[n] = cb->centre[i][0];
             y[n] = cb->centre[i][1];
@@ -90,7 +90,7 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, interval
  * enclosure spans both branches and the forms are loose where the interval
  * is not: csg, gyroid). Each test runs on all the children at once. Bit i of
  * centred[k] marks a drop by the form, of plain[k] by the plain test. */
-static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *fx,
                          child_boxes *cb, uint8_t *centred, uint8_t *plain)
 {
     const build_ctx *c = wk->c;
@@ -103,7 +103,7 @@ static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, interval
         retest_item it[8];
         uint8_t child[8], drop[8];
         for (unsigned i = 0; i < 8; i++)
-            if (!(T[k][i].lo > 0.0 || T[k][i].hi < 0.0) && child_box(cb, i)) {
+            if (!((fx[k] >> i) & 1) && child_box(cb, i)) {
                 retest_item r = {cb->box[i], cb->centre[i], wk->cf8[((size_t)s * 8 + i) * 4]};
                 child[n] = (uint8_t)i;
                 it[n++] = r;
@@ -136,9 +136,9 @@ static int takes_plain_test(unsigned depth, int ok)
 }
 
 /* The plain tests of the node's children (those takes_plain_test names,
- * inside the bounds, not dropped by T), all at once: bit i of drop[k] set
- * when the test proves child i empty of surface k. */
-static void children_plain_tests(worker *wk, unsigned depth, const uint8_t *ok, interval T[][8],
+ * inside the bounds, not dropped by the form, fx), all at once: bit i of
+ * drop[k] set when the test proves child i empty of surface k. */
+static void children_plain_tests(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *fx,
                                  child_boxes *cb, uint8_t *drop)
 {
     const unsigned ns = wk->c->nsurf, pidx = depth + 1;
@@ -150,7 +150,7 @@ static void children_plain_tests(worker *wk, unsigned depth, const uint8_t *ok, 
         retest_item it[8];
         uint8_t child[8], d[8];
         for (unsigned i = 0; i < 8; i++)
-            if (!(ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) && child_box(cb, i)) {
+            if (!(ok[k] && ((fx[k] >> i) & 1)) && child_box(cb, i)) {
                 retest_item r = {cb->box[i], cb->centre[i], 0.0};
                 child[n] = (uint8_t)i;
                 it[n++] = r;
@@ -184,20 +184,20 @@ static int child_dropped(worker *wk, unsigned depth, int ok, int plain_drop, uns
 typedef struct leaf_parent {
     uint64_t cell[3];
     unsigned slot; /* which child of its parent */
-    interval pbox[3], T[1][8];
+    interval pbox[3];
     double pc[3];
-    uint8_t ok[1], cand, nofd, cf8_have, centred[1], plain[1]; /* nofd: see skip_centre */
+    uint8_t ok[1], fx[1], cand, nofd, cf8_have, centred[1], plain[1]; /* nofd: see skip_centre */
     child_boxes cb;
     double cf8[32];
 } leaf_parent;
 
 /* The children of the node (depth, cell) in slot order, with the node's
- * forms (ok, T) and boxes (cb) made: their tests, then the voxels' records
+ * forms (ok, fx) and boxes (cb) made: their tests, then the voxels' records
  * (retest: a leaf-parent, its re-tests in centred and plain), or the
  * recursion. With batch, the children that would be recursed into are
  * appended to it instead (*nb of them), their mask bits left to the caller. */
 static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3],
-                              const uint8_t *ok, interval T[][8], child_boxes *cb, int retest,
+                              const uint8_t *ok, const uint8_t *fx, child_boxes *cb, int retest,
                               const uint8_t *centred, const uint8_t *plain, leaf_parent *batch,
                               unsigned *nb)
 {
@@ -206,7 +206,7 @@ static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3]
     newton nw[8];
     uint8_t child[8], surf[8], mask = 0, coarse[OCT_MAX_SURFACES];
     unsigned np = 0;
-    children_plain_tests(wk, depth, ok, T, cb, coarse);
+    children_plain_tests(wk, depth, ok, fx, cb, coarse);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         const interval *box = cb->box[i];
         const double *centre = cb->centre[i];
@@ -214,7 +214,7 @@ static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3]
         for (unsigned k = 0; k < wk->nact[pidx]; k++) {
             unsigned s = wk->act[(size_t)pidx * ns + k];
             const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-            if (ok[k] && (T[k][i].lo > 0.0 || T[k][i].hi < 0.0)) {
+            if (ok[k] && ((fx[k] >> i) & 1)) {
                 wk->st.taylor_drops++;
                 continue;
             }
@@ -288,7 +288,7 @@ static uint8_t shell_voxels(worker *wk, const leaf_parent *p)
     static const uint32_t empty[8];
     unsigned form_drops = 0;
     for (unsigned i = 0; i < 8; i++)
-        form_drops += p->T[0][i].lo > 0.0 || p->T[0][i].hi < 0.0;
+        form_drops += (p->fx[0] >> i) & 1;
     uint8_t keep = (uint8_t)(p->cand & ~(p->centred[0] | p->plain[0]));
     unsigned n = bits8(keep);
     wk->st.taylor_drops += form_drops + bits8(p->centred[0]);
@@ -315,15 +315,15 @@ static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
         leaf_parent *p = &lp[b];
         cell_box(c, depth, p->cell, p->pbox, p->pc);
         p->ok[0] = (uint8_t)child_enclosures(wk, t, p->pbox, depth, p->cell, wk->ncen[depth],
-                                             &wk->fcen[pidx], G, 1, p->T[0]);
+                                             &wk->fcen[pidx], G, 1, &p->fx[0]);
         child_boxes_init(c, depth, p->cell, p->pbox, &p->cb);
         p->cand = p->nofd = p->cf8_have = p->centred[0] = p->plain[0] = 0;
         for (unsigned i = 0; i < 8 && p->ok[0]; i++)
-            if (!(p->T[0][i].lo > 0.0 || p->T[0][i].hi < 0.0) && child_box(&p->cb, i))
+            if (!((p->fx[0] >> i) & 1) && child_box(&p->cb, i))
                 p->cand |= (uint8_t)(1u << i);
         for (unsigned i = 0; i < 8; i++) { /* f and grad f at the candidates' centres */
-            if (((p->cand >> i) & 1) && skip_centre(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, i,
-                                                     p->cf8 + 4 * i)) {
+            if (((p->cand >> i) & 1) &&
+                skip_centre(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, i, p->cf8 + 4 * i)) {
                 p->nofd |= (uint8_t)(1u << i);
             } else if ((p->cand >> i) & 1) {
                 x[n] = p->cb.centre[i][0];
@@ -426,7 +426,7 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
         wk->nact[pidx] = 1;
         wk->cf8 = p->cf8;
         wk->cf8_have[0] = wk->kinked[pidx] ? 0 : p->cf8_have;
-        uint8_t pm = visit_children(wk, depth, p->cell, p->ok, p->T, &p->cb, 1, p->centred,
+        uint8_t pm = visit_children(wk, depth, p->cell, p->ok, p->fx, &p->cb, 1, p->centred,
                                     p->plain, NULL, NULL);
         wk->cf8 = cf8;
         push_mask(wk, depth, pm);
@@ -444,9 +444,9 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
 {
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
-    interval pbox[3], T[OCT_MAX_SURFACES][8];
+    interval pbox[3];
     double pc[3];
-    uint8_t ok[OCT_MAX_SURFACES];
+    uint8_t ok[OCT_MAX_SURFACES], fx[OCT_MAX_SURFACES]; /* fx: children the form drops */
     cell_box(c, depth, cell, pbox, pc);
     memcpy(wk->ncen[pidx], pc, sizeof pc);
     /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
@@ -462,16 +462,16 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
             *fc = wk->fcen[(size_t)depth * ns + s];
         }
         ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, depth, cell,
-                                          r ? wk->ncen[depth] : pc, fc, G, r, T[k]);
+                                          r ? wk->ncen[depth] : pc, fc, G, r, &fx[k]);
         wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
-    child_boxes cb; /* most children fall to T alone: boxes are made lazily */
+    child_boxes cb; /* most children fall to the form alone: boxes are made lazily */
     child_boxes_init(c, depth, cell, pbox, &cb);
     int retest = depth + 1 == c->levels && depth + 1 >= MEAN_VALUE_ALONE_DEPTH;
     uint8_t centred[OCT_MAX_SURFACES], plain[OCT_MAX_SURFACES];
     if (retest) {
-        leaf_centres(wk, depth, ok, T, &cb);
-        leaf_retests(wk, depth, ok, T, &cb, centred, plain);
+        leaf_centres(wk, depth, ok, fx, &cb);
+        leaf_retests(wk, depth, ok, fx, &cb, centred, plain);
     }
     /* The parent of leaf-parents, one surface, its form there for them to
      * reuse: they go to one batch. */
@@ -479,10 +479,10 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
         wk->nact[pidx] == 1 && ok[0]) {
         leaf_parent batch[8];
         unsigned nb = 0;
-        uint8_t mask = visit_children(wk, depth, cell, ok, T, &cb, 0, NULL, NULL, batch, &nb);
+        uint8_t mask = visit_children(wk, depth, cell, ok, fx, &cb, 0, NULL, NULL, batch, &nb);
         return nb && !wk->failed ? mask | leaf_batch(wk, depth + 1, batch, nb) : mask;
     }
-    return visit_children(wk, depth, cell, ok, T, &cb, retest, centred, plain, NULL, NULL);
+    return visit_children(wk, depth, cell, ok, fx, &cb, retest, centred, plain, NULL, NULL);
 }
 
 /* Builds the subtree of a cell already tested non-empty; returns its child
