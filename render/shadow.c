@@ -37,6 +37,8 @@ static int voxel_occupied(const oct_tree *tree, const double g[3], shadow_start 
 static int start_from(const oct_tree *tree, const double base[3], const float n[3],
                       shadow_start *s)
 {
+    if (!s->near)
+        s->dir_ok = 0; /* a new tree, or a new shadow_start: no direction kept */
     const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double g[3];
     for (unsigned k = 0; k < SHADOW_TRIES; k++) {
@@ -129,10 +131,19 @@ int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_
 }
 
 int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
-                        const shadow_start *s, const double d[3], double t_max, uint64_t *steps)
+                        shadow_start *s, const double d[3], double t_max, uint64_t *steps)
 {
+    if (!s->eye.ok)
+        return 0; /* as trace_setup: no ray */
+    /* +0 and -0 make the same set-up, NaN never matches: == is enough */
+    trace_dir *td = &s->dir;
+    if (!s->dir_ok || td->dir[0] != d[0] || td->dir[1] != d[1] || td->dir[2] != d[2] ||
+        td->scale != s->eye.scale) {
+        trace_dir_init(&s->eye, d, td);
+        s->dir_ok = 1;
+    }
     trace_ray r;
-    if (!trace_setup_eye(&s->eye, d, &r))
+    if (!trace_setup_dir(&s->eye, td, &r))
         return 0; /* as trace_setup: the ray misses the cube */
     if (t_max < INFINITY && !trace_clip(&r, 0.0, t_max))
         return 0;

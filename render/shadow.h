@@ -61,6 +61,9 @@ typedef struct shadow_start {
     int near;            /* in and out: 1 when anchor holds an earlier start's
                             anchor (same tree), which speeds the next search
                             up (trace_anchor_find_near); 0 the first time */
+    trace_dir dir;       /* the direction part of the last shadow ray's set-up
+                            (the light's, the same from hit to hit) */
+    int dir_ok;          /* dir is set (cleared when near is 0) */
 } shadow_start;
 
 /* shadow_origin and shadow_origin_at, with the shared part in *s (set
@@ -85,8 +88,9 @@ int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_
                    const double o[3], const double d[3], double t_max, uint64_t *steps);
 
 /* shadow_blocked from s->o, started at s's anchor: the same answer and
- * steps. */
+ * steps. The set-up's direction part is kept in s for the next call with
+ * the same d. */
 int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
-                        const shadow_start *s, const double d[3], double t_max, uint64_t *steps);
+                        shadow_start *s, const double d[3], double t_max, uint64_t *steps);
 
 #endif

@@ -99,6 +99,23 @@ typedef struct trace_eye {
 int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e);
 int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r);
 
+/* The direction's part of trace_setup_eye, made once for many rays of one
+ * direction (shadow rays towards one light): trace_setup_dir(e, td, r) sets
+ * up trace_setup_eye(e, td->dir, r)'s ray, bit for bit, for every eye e of
+ * the tree (the grid scale) td was made for; from an eye inside the root
+ * cube without a division. */
+typedef struct trace_dir {
+    double dir[3];     /* as given */
+    double scale;      /* the tree's N / edge (trace_eye's) */
+    double d[3], inv[3]; /* trace_ray's: 0 and 1 on a zero axis */
+    int32_t sgn[3];
+    unsigned active;
+    int ok;            /* 0: no ray of this direction can be set up */
+} trace_dir;
+
+void trace_dir_init(const trace_eye *e, const double dir[3], trace_dir *td);
+int trace_setup_dir(const trace_eye *e, const trace_dir *td, trace_ray *r);
+
 /* Restricts a prepared ray to the caller's t in [t_lo, t_hi]: the traversal
  * starts in the cell the ray is in at t_lo (chosen by the tie rule, as if it
  * had walked there) and stops at t_hi. When no occupied voxel meets the ray

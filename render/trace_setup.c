@@ -1,5 +1,6 @@
 /* trace_setup: a ray mapped into a tree's grid and clipped to its root cube
- * (trace_setup, trace_eye_init / trace_setup_eye, trace_clip), and the
+ * (trace_setup, trace_eye_init / trace_setup_eye, trace_dir_init /
+ * trace_setup_dir, trace_clip), and the
  * anchors a bundle of rays starts from (trace_anchor_find). See trace.h. */
 #include "render/trace.h"
 
@@ -104,6 +105,66 @@ int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
     if (e->all_inside)
         return setup_inside(e, dir, r);
     return trace_setup_eye_general(e, dir, r);
+}
+
+void trace_dir_init(const trace_eye *e, const double dir[3], trace_dir *td)
+{
+    const double scale = e->scale;
+    double d[3];
+    unsigned active = 0;
+    for (int a = 0; a < 3; a++) {
+        td->dir[a] = dir[a];
+        d[a] = dir[a] * scale;
+    }
+    td->scale = scale;
+    td->ok = 0;
+    if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
+        return;
+    for (int a = 0; a < 3; a++) { /* setup_inside's per-axis part */
+        const double inv = 1.0 / d[a];
+        const int act = fabs(inv) <= DBL_MAX;
+        active |= (unsigned)act << a;
+        td->inv[a] = act ? inv : 1.0;
+        td->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
+        td->d[a] = act ? d[a] : 0.0;
+    }
+    td->active = active;
+    td->ok = active != 0;
+}
+
+int trace_setup_dir(const trace_eye *e, const trace_dir *td, trace_ray *r)
+{
+    if (!e->ok)
+        return 0;
+    if (!e->all_inside)
+        return trace_setup_eye_general(e, td->dir, r);
+    if (!td->ok)
+        return 0;
+    /* setup_inside with the direction's part made: the same values */
+    const unsigned active = td->active;
+    double t_end = INFINITY;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const int act = active >> a & 1u;
+        r->inv[a] = td->inv[a];
+        r->sgn[a] = td->sgn[a];
+        r->d[a] = td->d[a];
+        r->o[a] = e->o[a];
+        r->ot[a] = act ? e->o[a] : -INFINITY;
+        r->v[a] = act ? 0u : floor_clamp(e->o[a], 0, e->nvox - 1);
+        if (act) {
+            const double te = (td->d[a] < 0.0 ? e->lo[a] : e->hi[a]) * td->inv[a];
+            if (te < t_end)
+                t_end = te;
+        }
+    }
+    if (!(t_end > 0.0))
+        return 0;
+    r->active = active;
+    r->t_base = 0.0;
+    r->t_start = 0.0;
+    r->t_end = t_end;
+    return 1;
 }
 
 int trace_setup_eye_general(const trace_eye *e, const double dir[3], trace_ray *r)

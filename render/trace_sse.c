@@ -17,6 +17,12 @@
  * stays in registers. */
 #define SSE_INLINE static inline __attribute__((always_inline))
 
+/* lane masks for a 3-bit axis set */
+static const int32_t trace_lut[8][4] __attribute__((aligned(16))) = {
+    {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
+    {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+};
+
 /* A ray's plane-time parameters per lane: T(k) = (k - ZO) * ZI. */
 typedef struct sse_axes {
     __m128d ZOxy, ZOzw, ZIxy, ZIzw;
@@ -27,7 +33,7 @@ typedef struct sse_axes {
 } sse_axes;
 
 /* The axes of ray r in a tree of `levels` levels, and the root's exit
- * times. A zero axis uses o = v + 1/2, inv = +inf. */
+ * times (TRxy NULL: not wanted). A zero axis uses o = v + 1/2, inv = +inf. */
 SSE_INLINE void sse_axes_init(const trace_ray *r, unsigned levels, sse_axes *ax, __m128d *TRxy,
                               __m128d *TRzw)
 {
@@ -40,7 +46,8 @@ SSE_INLINE void sse_axes_init(const trace_ray *r, unsigned levels, sse_axes *ax,
         zo[a] = act ? r->ot[a] : (double)r->v[a] + 0.5;
         zi[a] = act ? r->inv[a] : INFINITY;
         far |= (r->sgn[a] > 0 ? 1u : 0u) << a; /* sgn is +1 on a zero axis */
-        root[a] = ((far >> a & 1u ? nroot : 0.0) - zo[a]) * zi[a];
+        if (TRxy)
+            root[a] = ((far >> a & 1u ? nroot : 0.0) - zo[a]) * zi[a];
     }
     zo[3] = 0.0;
     zi[3] = 0.0;
@@ -55,8 +62,10 @@ SSE_INLINE void sse_axes_init(const trace_ray *r, unsigned levels, sse_axes *ax,
     ax->zoz = zo[2];
     ax->ziz = zi[2];
     ax->far = far;
-    *TRxy = _mm_loadu_pd(root);
-    *TRzw = _mm_loadu_pd(root + 2);
+    if (TRxy) {
+        *TRxy = _mm_loadu_pd(root);
+        *TRzw = _mm_loadu_pd(root + 2);
+    }
 }
 
 /* The exit times of the cell with corner V (bits below `edge` ignored) and
@@ -74,10 +83,15 @@ SSE_INLINE void trace_cell_exits(__m128i V, uint32_t edge, const sse_axes *ax, _
         ax->WINF);
 }
 
-/* lane masks for a 3-bit axis set */
-static const int32_t trace_lut[8][4] __attribute__((aligned(16))) = {
-    {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
-    {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+
+/* 64-bit lane masks (as blendv reads them) of a 3-bit axis set: (x, y), (z, w) */
+static const double trace_near64[8][2][2] __attribute__((aligned(16))) = {
+#define NM(b) ((b) ? -NAN : 0.0)
+    {{NM(0), NM(0)}, {NM(0), 0.0}}, {{NM(1), NM(0)}, {NM(0), 0.0}},
+    {{NM(0), NM(1)}, {NM(0), 0.0}}, {{NM(1), NM(1)}, {NM(0), 0.0}},
+    {{NM(0), NM(0)}, {NM(1), 0.0}}, {{NM(1), NM(0)}, {NM(1), 0.0}},
+    {{NM(0), NM(1)}, {NM(1), 0.0}}, {{NM(1), NM(1)}, {NM(1), 0.0}},
+#undef NM
 };
 
 /* enter (the paper's vertical traverse, Fig. 2, one level): the child of
@@ -347,7 +361,7 @@ int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anc
 
     sse_axes ax;
     __m128d TPxy, TPzw;
-    sse_axes_init(r, levels, &ax, &TPxy, &TPzw);
+    sse_axes_init(r, levels, &ax, NULL, NULL);
     const unsigned far = ax.far;
 
     trace_frame fr[OCT_MAX_LEVELS];
@@ -386,9 +400,8 @@ int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anc
         Pn = fr[d].prefix;
         goto look;
     }
-    /* from the root, tested like any other cell */
-    Txy = TPxy;
-    Tzw = TPzw;
+    /* from the root, tested like any other cell (its exits: sse_axes_init's) */
+    trace_cell_exits(V, size, &ax, &Txy, &Tzw);
     Mn = M;
     Pn = P;
     goto look;
@@ -410,21 +423,21 @@ int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anc
             const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ax.ZOxy), ax.ZIxy);
             const __m128d TMzw = _mm_mul_pd(
                 _mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ax.ZOzw), ax.ZIzw);
-            const __m128d Nxy = _mm_cmplt_pd(TC, TMxy), Nzw = _mm_cmplt_pd(TC, TMzw);
             const __m128d m2 = _mm_min_pd(Txy, Tzw);
             const __m128d LIM = _mm_min_pd(_mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)), TEND);
-            /* one 32-bit lane per axis (w: 0) for each mask, read by one movemask */
-            const __m128 Nv = _mm_shuffle_ps(_mm_castpd_ps(Nxy), _mm_castpd_ps(Nzw),
-                                             _MM_SHUFFLE(2, 0, 2, 0));
-            const __m128 Cv = _mm_and_ps(
-                Nv, _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TMxy, LIM)),
-                                   _mm_castpd_ps(_mm_cmplt_pd(TMzw, LIM)), _MM_SHUFFLE(2, 0, 2, 0)));
-            const __m128 Ov = _mm_shuffle_ps(
-                _mm_castpd_ps(_mm_cmplt_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))),
-                _mm_castpd_ps(_mm_cmplt_pd(TMxy, TMzw)), _MM_SHUFFLE(0, 0, 2, 0));
-            const unsigned c0 = (unsigned)_mm_movemask_ps(Nv) ^ far;
-            const unsigned crossed = (unsigned)_mm_movemask_ps(Cv);
-            const unsigned order = (unsigned)_mm_movemask_ps(Ov) & 7u;
+            /* one 32-bit lane per axis (w: 0) for each comparison, read by one movemask */
+            const unsigned near = (unsigned)_mm_movemask_ps(
+                _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TC, TMxy)),
+                               _mm_castpd_ps(_mm_cmplt_pd(TC, TMzw)), _MM_SHUFFLE(2, 0, 2, 0)));
+            const unsigned before = (unsigned)_mm_movemask_ps(
+                _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TMxy, LIM)),
+                               _mm_castpd_ps(_mm_cmplt_pd(TMzw, LIM)), _MM_SHUFFLE(2, 0, 2, 0)));
+            const unsigned order = (unsigned)_mm_movemask_ps(_mm_shuffle_ps(
+                                       _mm_castpd_ps(_mm_cmplt_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))),
+                                       _mm_castpd_ps(_mm_cmplt_pd(TMxy, TMzw)), _MM_SHUFFLE(0, 0, 2, 0))) &
+                                   7u;
+            const unsigned c0 = near ^ far;
+            const unsigned crossed = near & before;
             if (!(trace_path_children[c0 | crossed << 3 | order << 6] & Mn)) {
                 if (!d)
                     break; /* the root */
@@ -448,8 +461,8 @@ int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anc
             P = Pn;
             TPxy = Txy;
             TPzw = Tzw;
-            Txy = _mm_blendv_pd(TPxy, TMxy, Nxy);
-            Tzw = _mm_blendv_pd(TPzw, TMzw, Nzw);
+            Txy = _mm_blendv_pd(TPxy, TMxy, _mm_load_pd(trace_near64[near][0]));
+            Tzw = _mm_blendv_pd(TPzw, TMzw, _mm_load_pd(trace_near64[near][1]));
             ci = c0;
             V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[ci])));
             size = half;

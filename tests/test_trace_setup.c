@@ -23,8 +23,9 @@ static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
 
 /* trace_setup_eye's shortcut for eyes inside the root cube gives the ray
- * of the general path, bit for bit: eyes anywhere inside, on faces, edges
- * and corners, directions with zero, tiny and huge components. */
+ * of the general path, bit for bit, and so does trace_setup_dir: eyes
+ * anywhere inside, on faces, edges and corners, directions with zero, tiny
+ * and huge components. */
 static void test_setup_inside_same_ray(void **state)
 {
     (void)state;
@@ -53,6 +54,14 @@ static void test_setup_inside_same_ray(void **state)
             const int ok0 = trace_setup_eye_general(&e, dir, &r0);
             const int ok1 = trace_setup_eye(&e, dir, &r1);
             assert_int_equal(ok1, ok0);
+            /* the direction's part made once (trace_dir): the same ray */
+            trace_dir td;
+            trace_dir_init(&e, dir, &td);
+            trace_ray r2;
+            memset(&r2, 0, sizeof r2);
+            assert_int_equal(trace_setup_dir(&e, &td, &r2), ok0);
+            if (ok0)
+                assert_memory_equal(&r2, &r1, sizeof r1);
             if (ok0) {
                 assert_memory_equal(r1.o, r0.o, sizeof r0.o);
                 assert_memory_equal(r1.ot, r0.ot, sizeof r0.ot);
