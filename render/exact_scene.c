@@ -19,7 +19,7 @@ typedef struct builder {
     struct {
         uint64_t exact[2], cull[2]; /* insn, konst pool offsets; UINT64_MAX: the whole tape */
     } *off;                         /* per candidate */
-    interval *slots;
+    interval *slots, *kslots;
     tape_ihess *hslots;
     tape_insn *tmp_insn;
     tape_const *tmp_konst;
@@ -41,12 +41,9 @@ static int grow(void **p, size_t *cap, size_t need, size_t size)
     return 0;
 }
 
-/* The world box of coarse cell c (cells of `size` voxels), grown by 2^-8
- * voxel each side (more than the 2^-16 voxel a test span is widened by) and
- * rounded outward, so every span tested in it lies inside. */
-static void cell_box(const exact_scene *es, const uint32_t c[3], uint32_t size, interval box[3])
+void exact_scene_box(const exact_scene *es, unsigned d, const uint32_t c[3], interval box[3])
 {
-    const double m = 0x1p-8;
+    const double m = 0x1p-8, size = ldexp(1.0, (int)(es->tree->levels - d));
     for (int a = 0; a < 3; a++) {
         const double lo = es->tree->origin[a] + ((double)c[a] * size - m) * es->h;
         const double hi = es->tree->origin[a] + ((double)(c[a] + 1) * size + m) * es->h;
@@ -99,13 +96,12 @@ static int add_cell(builder *b, const uint32_t c[3])
 {
     exact_scene *es = b->es;
     const unsigned D = es->depth, L = es->tree->levels;
-    const uint32_t size = UINT32_C(1) << (L - D);
     size_t cap = b->cap_cells;
     if (grow((void **)&es->first, &cap, (size_t)es->ncells + 2, sizeof *es->first))
         return -1;
     b->cap_cells = (uint32_t)cap;
     interval box[3];
-    cell_box(es, c, size, box);
+    exact_scene_box(es, D, c, box);
     es->first[es->ncells] = es->ncand;
     for (uint32_t s = 0; s < b->nsurf; s++) {
         const tape *t = &b->tapes[s];
@@ -128,7 +124,8 @@ static int add_cell(builder *b, const uint32_t c[3])
                          &es->pruned_insns))
             return -1;
         /* (k->t's arrays are still those tape_prune_const wrote, or t's) */
-        tape_hess_mag(&k->t, box, b->hslots, k->hmag);
+        tape_hess_mags(&k->t, box, b->hslots, k->hmag, k->hbranch);
+        k->kinks = tape_hess_kinks(&k->t, box, b->kslots);
         if (store_pruned(b, t, flags, 1e-3 * per_voxel, &k->cull, b->off[es->ncand].cull,
                          &es->cull_insns))
             return -1;
@@ -169,6 +166,10 @@ int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, u
     if (es->depth > EXACT_CELL_MAX_DEPTH)
         es->depth = EXACT_CELL_MAX_DEPTH;
     es->h = ldexp(tree->edge, -(int)tree->levels);
+    /* sub-cells down to the voxels' parents */
+    es->sub_max = tree->levels > es->depth + 1 ? tree->levels - 1 - es->depth : 0;
+    if (es->sub_max > EXACT_SUB_MAX_REL)
+        es->sub_max = EXACT_SUB_MAX_REL;
     builder b;
     memset(&b, 0, sizeof b);
     b.es = es;
@@ -185,12 +186,13 @@ int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, u
     const size_t cells = (size_t)1 << (3 * es->depth);
     es->cell_slot = malloc(cells * sizeof *es->cell_slot);
     b.slots = malloc(nmax * sizeof *b.slots);
+    b.kslots = malloc(nmax * sizeof *b.kslots);
     b.hslots = malloc(nmax * sizeof *b.hslots);
     b.tmp_insn = malloc(nmax * sizeof *b.tmp_insn);
     b.tmp_konst = malloc(((size_t)cmax + nmax) * sizeof *b.tmp_konst);
     b.tmp_scratch = malloc(nmax * sizeof *b.tmp_scratch);
     int rc = -1;
-    if (es->cell_slot && b.slots && b.hslots && b.tmp_insn && b.tmp_konst && b.tmp_scratch) {
+    if (es->cell_slot && b.slots && b.kslots && b.hslots && b.tmp_insn && b.tmp_konst && b.tmp_scratch) {
         memset(es->cell_slot, 0xff, cells * sizeof *es->cell_slot);
         const uint32_t root[3] = {0, 0, 0};
         rc = tree->node_count[0] ? visit(&b, 0, 0, root) : 0;
@@ -211,6 +213,7 @@ int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, u
     }
     free(b.off);
     free(b.slots);
+    free(b.kslots);
     free(b.hslots);
     free(b.tmp_insn);
     free(b.tmp_konst);
@@ -237,11 +240,18 @@ int exact_worker_init(exact_worker *w, const exact_scene *es)
     w->key_slot = UINT32_MAX;
     w->key_t = 0.0;
     w->have = 0;
-    return exact_scratch_init(&w->scratch, es->max_n);
+    if (exact_scratch_init(&w->scratch, es->max_n))
+        return -1;
+    if (exact_sub_init(&w->sub, es->ncand, es->max_n)) {
+        exact_scratch_free(&w->scratch);
+        return -1;
+    }
+    return 0;
 }
 
 void exact_worker_free(exact_worker *w)
 {
+    exact_sub_free(&w->sub);
     exact_scratch_free(&w->scratch);
     w->scene = NULL;
 }
@@ -281,41 +291,60 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
     if (a < -r->t_base)
         a = -r->t_base; /* the caller's t >= 0 */
     double best = INFINITY;
+    tape win; /* the winner's exact tape */
     uint32_t best_k = 0;
+    if (es->sub_max)
+        exact_sub_reserve(&w->sub);
     for (uint32_t k = es->first[slot]; k < es->first[slot + 1]; k++) {
         if (!(a <= b))
             break;
+        /* the cell's tapes and bound, or where that is +inf its sub-cell's */
         const exact_cand *c = &es->cand[k];
-        const double curv = exact_fast_curv(c->hmag, l.d);
+        const tape *t_exact = &c->t, *t_cull = &c->cull;
+        const double *hmag = c->hmag;
+        uint64_t key = 0;
+        if (!(hmag[0] < INFINITY) && es->sub_max && (c->kinks & EXACT_SUB_KINKS)) {
+            const exact_region *rg = exact_sub_find(&w->sub, es, k, v);
+            if (rg->empty) {
+                w->fast++;
+                continue;
+            }
+            t_exact = &rg->t;
+            t_cull = &rg->cull;
+            hmag = rg->hmag;
+            key = rg->key;
+        }
+        const double curv = exact_fast_curv(hmag, l.d);
         double t = INFINITY;
         int st = EXACT_FAST_UNDECIDED;
         const uint32_t j = k - es->first[slot];
         if (curv < INFINITY && j < EXACT_MODELS) {
-            int have = w->have >> j & 1u;
-            st = exact_fast_root(&c->t, &w->scratch, &l, a, b, curv, &w->model[j], &have, &t);
+            int have = (w->have >> j & 1u) && w->model_key[j] == key;
+            st = exact_fast_root(t_exact, &w->scratch, &l, a, b, curv, &w->model[j], &have, &t);
             w->have = (w->have & ~(UINT32_C(1) << j)) | (uint32_t)have << j;
+            w->model_key[j] = key;
         }
         if (st == EXACT_FAST_UNDECIDED) {
             w->slow++;
-            t = exact_first_root(&c->t, &c->cull, &w->scratch, &l, a, b, NULL);
+            t = exact_first_root(t_exact, t_cull, &w->scratch, &l, a, b, NULL);
         } else {
             w->fast++;
         }
         if (t < best) {
             best = t;
             best_k = k;
+            win = *t_exact;
             b = t; /* a later surface must be nearer to win */
         }
     }
     if (!(best < INFINITY))
         return 0;
-    const exact_cand *c = &es->cand[best_k];
     double p[3];
     for (int k = 0; k < 3; k++)
         p[k] = l.o[k] + best * l.d[k];
-    exact_normal(&c->t, &w->scratch, p, l.d, hit->normal);
+    exact_normal(&win, &w->scratch, p, l.d, hit->normal);
     hit->exact = 1;
-    hit->surface = c->surface;
+    hit->surface = es->cand[best_k].surface;
     *t_hit = best;
     return 1;
 }

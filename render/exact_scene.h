@@ -12,6 +12,7 @@
 #include "format/oct.h"
 #include "render/exact_fast.h"
 #include "render/exact_hit.h"
+#include "render/exact_sub.h"
 #include "render/trace.h"
 
 /* Coarse depth (docs/perf-log.md, "render --exact"). */
@@ -26,6 +27,9 @@ typedef struct exact_cand {
     tape cull;        /* pruned coarsely, for the interval that drops segments */
     double hmag[6];   /* magnitudes of t's Hessian enclosure over the cell
                          (tape_hess_mag): +inf where the fast path is off */
+    double hbranch[6]; /* the same with kinks allowed (tape_hess_mags): what
+                          bounds the sub-cells where t has none (exact_sub.h) */
+    unsigned kinks;    /* tape_hess_kinks of t over the cell */
 } exact_cand;
 
 typedef struct exact_scene {
@@ -38,6 +42,7 @@ typedef struct exact_scene {
     uint32_t max_n;      /* most instructions of any tape (scratch size) */
     uint64_t whole_insns, pruned_insns, cull_insns; /* statistics: sum over candidates */
     double h;            /* world units per voxel: edge / 2^L */
+    unsigned sub_max;    /* deepest sub-cells (exact_sub.h), relative to depth; 0: none */
     tape_insn *insn_pool;
     tape_const *konst_pool;
 } exact_scene;
@@ -49,20 +54,29 @@ typedef struct exact_scene {
 int exact_scene_init(exact_scene *es, const oct_tree *tree, const tape *tapes, unsigned depth);
 void exact_scene_free(exact_scene *es); /* accepts a zeroed or freed one */
 
+/* The world box of the tree's cell of depth d (<= the tree's levels) with
+ * corner c (in cells of that depth), grown by 2^-8 voxel each side (more
+ * than the 2^-16 voxel a test span is widened by) and rounded outward, so
+ * every span tested in it lies inside. */
+void exact_scene_box(const exact_scene *es, unsigned d, const uint32_t c[3], interval box[3]);
+
 #define EXACT_MODELS 8 /* candidates of a cell that keep a model */
 
 /* A thread's state for the exact test: the scene and scratch for its tapes. */
 typedef struct exact_worker {
     const exact_scene *scene;
     exact_scratch scratch;
+    exact_sub_cache sub; /* its own sub-cells */
     uint64_t fast, slow; /* statistics: candidate tests the fast path decided, and not */
     /* The fast path's models (exact_fast.h) for the line of the last test
      * (key: o, d; key_t: its t_in), valid while its voxels stay in one
      * coarse cell: candidate k of the cell has one when bit k of `have` is
-     * set. */
+     * set, for the region (the cell or a sub-cell: exact_region.key)
+     * model_key[k]. */
     double key[6], key_t;
     uint32_t key_slot, have;
     exact_model model[EXACT_MODELS];
+    uint64_t model_key[EXACT_MODELS];
 } exact_worker;
 
 int exact_worker_init(exact_worker *w, const exact_scene *es); /* 0, or -1: out of memory */

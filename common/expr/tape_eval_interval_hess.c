@@ -196,12 +196,9 @@ interval tape_eval_interval_hess(const tape *t, const interval box[3], interval 
     return r->v;
 }
 
-int tape_hess_mag(const tape *t, const interval box[3], tape_ihess *slots, double mag[TAPE_HN])
+/* Magnitudes of finite entries into mag (1), else +inf everywhere (0). */
+static int magnitudes(const interval h[TAPE_HN], int ok, double mag[TAPE_HN])
 {
-    interval g[3], h[TAPE_HN];
-    unsigned flags = 0;
-    tape_eval_interval_hess(t, box, g, h, slots, &flags);
-    int ok = flags == 0;
     for (int e = 0; ok && e < TAPE_HN; e++) {
         ok = is_finite(h[e]);
         mag[e] = ok ? fmax(fabs(h[e].lo), fabs(h[e].hi)) : INFINITY;
@@ -210,4 +207,43 @@ int tape_hess_mag(const tape *t, const interval box[3], tape_ihess *slots, doubl
         for (int e = 0; e < TAPE_HN; e++)
             mag[e] = INFINITY;
     return ok;
+}
+
+int tape_hess_mag(const tape *t, const interval box[3], tape_ihess *slots, double mag[TAPE_HN])
+{
+    interval g[3], h[TAPE_HN];
+    unsigned flags = 0;
+    tape_eval_interval_hess(t, box, g, h, slots, &flags);
+    return magnitudes(h, flags == 0, mag);
+}
+
+void tape_hess_mags(const tape *t, const interval box[3], tape_ihess *slots, double mag[TAPE_HN],
+                    double branch[TAPE_HN])
+{
+    interval g[3], h[TAPE_HN];
+    unsigned flags = 0;
+    tape_eval_interval_hess(t, box, g, h, slots, &flags);
+    magnitudes(h, flags == 0, mag);
+    magnitudes(h, (flags & ~(unsigned)TAPE_HESS_KINK) == 0, branch);
+}
+
+unsigned tape_hess_kinks(const tape *t, const interval box[3], interval *slots)
+{
+    unsigned flags = 0, kinks = 0;
+    tape_eval_interval(t, box, slots, &flags);
+    if (flags)
+        kinks |= TAPE_KINK_FLAG;
+    for (uint32_t i = 0; i < t->n; i++) {
+        const tape_insn *in = &t->insn[i];
+        if (in->op == TAPE_ABS) {
+            const interval a = slots[in->a];
+            if (!(a.lo >= 0.0 || a.hi <= 0.0))
+                kinks |= TAPE_KINK_ABS;
+        } else if (in->op == TAPE_MIN || in->op == TAPE_MAX) {
+            const interval a = slots[in->a], c = slots[in->b];
+            if (!(a.hi < c.lo || c.hi < a.lo))
+                kinks |= TAPE_KINK_MINMAX;
+        }
+    }
+    return kinks;
 }

@@ -36,4 +36,26 @@ interval tape_eval_interval_hess(const tape *t, const interval box[3], interval 
 int tape_hess_mag(const tape *t, const interval box[3], tape_ihess *slots,
                   double mag[TAPE_HN]);
 
+/* tape_hess_mag's magnitudes in mag[], and in branch[] those of the same
+ * enclosure with the kinks allowed (+inf only when flagged otherwise, i.e.
+ * f may be undefined in the box, or an entry is not finite): a min/max
+ * whose operands overlap encloses both operands' derivatives, an abs of
+ * an operand holding 0 has its first derivative in [-1, 1] and its second
+ * 0. So branch[] bounds |d^T Hess f(p) d| on every sub-box of the box where
+ * f has no kink (tape_hess_kinks is 0 for it, or for a tape_prune of it for
+ * that sub-box): there every min/max keeps one operand and every abs one
+ * sign, f is the composition of those branches, and each instruction's
+ * enclosure over the box holds its branch's derivatives at the sub-box's
+ * points. */
+void tape_hess_mags(const tape *t, const interval box[3], tape_ihess *slots, double mag[TAPE_HN],
+                    double branch[TAPE_HN]);
+
+/* What may keep f from being twice differentiable in the box, by the rule
+ * of TAPE_HESS_KINK: a mask of TAPE_KINK_ABS (an abs of an operand whose
+ * enclosure holds 0 inside), TAPE_KINK_MINMAX (a min/max whose operands'
+ * enclosures overlap) and TAPE_KINK_FLAG (f may be undefined there); 0:
+ * none. `slots`: t->n elements (one interval evaluation over the box). */
+enum { TAPE_KINK_ABS = 1u, TAPE_KINK_MINMAX = 2u, TAPE_KINK_FLAG = 4u };
+unsigned tape_hess_kinks(const tape *t, const interval box[3], interval *slots);
+
 #endif
