@@ -1,13 +1,18 @@
 /* The seed corpus generator of the fuzz_oct target (tests/fuzz/README.md):
- * writes its files when OCT_CORPUS_DIR is set, and is skipped otherwise. */
+ * writes its files to OCT_CORPUS_DIR when that is set, else to a temporary
+ * directory; either way every seed is then opened: an ok-* seed must open,
+ * a bad-* seed must be refused (so the corpus holds what its names say). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 #include "format/oct.h"
 #include "format/oct_layout.h"
@@ -58,12 +63,46 @@ static void make_1_1_seeds(const char *dir)
     test_tree_free(&t);
 }
 
+/* Every seed in dir opens (ok-*) or is refused (bad-*); own: remove them. */
+static void check_seeds(const char *dir, int own)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    unsigned ok = 0, bad = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        const int is_ok = !strncmp(e->d_name, "ok-", 3), is_bad = !strncmp(e->d_name, "bad-", 4);
+        if (!is_ok && !is_bad)
+            continue;
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        oct_file *f = NULL;
+        const oct_err rc = oct_open(path, 0, &f, NULL);
+        if (is_ok && rc != OCT_OK)
+            fail_msg("%s: %s", e->d_name, oct_strerror(rc));
+        if (is_bad && rc == OCT_OK)
+            fail_msg("%s: opened", e->d_name);
+        oct_close(f);
+        is_ok ? ok++ : bad++;
+        if (own)
+            assert_int_equal(unlink(path), 0);
+    }
+    closedir(d);
+    if (own)
+        assert_int_equal(rmdir(dir), 0);
+    assert_int_equal(ok, 21); /* levels 1..6 x 3 variants, three 1.1 seeds */
+    assert_int_equal(bad, 6);
+}
+
 static void test_make_fuzz_corpus(void **state)
 {
     (void)state;
+    char tmp[] = "/tmp/oct-corpus-XXXXXX";
     const char *dir = getenv("OCT_CORPUS_DIR");
-    if (!dir)
-        skip();
+    const int own = !dir || !*dir;
+    if (own) {
+        dir = mkdtemp(tmp);
+        assert_non_null(dir);
+    }
     for (uint32_t levels = 1; levels <= 6; levels++) {
         for (int variant = 0; variant < 3; variant++) {
             test_tree t;
@@ -102,6 +141,7 @@ static void test_make_fuzz_corpus(void **state)
         }
     }
     make_1_1_seeds(dir);
+    check_seeds(dir, own);
 }
 
 int main(void)
