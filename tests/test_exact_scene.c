@@ -19,65 +19,10 @@
 #include "bench/compare.h"
 #include "bench/refcast.h"
 #include "common/expr/scene.h"
-#include "common/expr/tape_io.h"
-#include "rasterize/build.h"
 #include "render/exact_scene.h"
 #include "render/frame.h"
-#include "render/stored_tapes.h"
 #include "render/trace_impl.h"
-
-typedef struct built {
-    scene *sc;
-    char *bytes;
-    size_t size;
-    oct_file *file;
-    const oct_tree *tree;
-    stored_tapes st; /* the file's own tapes, as render loads them */
-    exact_scene es;
-} built;
-
-static void build(const char *text, unsigned levels, unsigned depth, built *b)
-{
-    memset(b, 0, sizeof *b);
-    scene_error err;
-    assert_int_equal(scene_parse(text, strlen(text), &b->sc, &err), 0);
-    float palette[3 * OCT_MAX_SURFACES];
-    oct_writer_params wp;
-    build_writer_params(b->sc, levels, palette, &wp);
-    const tape *tp[OCT_MAX_SURFACES];
-    for (size_t s = 0; s < b->sc->nsurfaces; s++)
-        tp[s] = &b->sc->surfaces[s].tape;
-    unsigned char *fn = NULL;
-    assert_int_equal(tape_io_encode(tp, (unsigned)b->sc->nsurfaces, &fn, &wp.function_size), TAPE_OK);
-    wp.function = fn;
-    oct_writer *w = NULL;
-    assert_int_equal(oct_writer_create(&wp, &w), OCT_OK);
-    build_params bp = {.levels = levels, .method = BUILD_INTERVAL, .threads = 2};
-    build_stats st;
-    assert_int_equal(build_octree(b->sc, &bp, w, &st), OCT_OK);
-    FILE *mem = open_memstream(&b->bytes, &b->size);
-    assert_non_null(mem);
-    uint64_t n = 0;
-    assert_int_equal(oct_writer_finish(w, mem, &n), OCT_OK);
-    assert_int_equal(fclose(mem), 0);
-    oct_writer_free(w);
-    free(fn);
-    uint64_t off = 0;
-    assert_int_equal(oct_open_memory(b->bytes, b->size, 0, &b->file, &off), OCT_OK);
-    b->tree = oct_get_tree(b->file);
-    assert_int_equal(stored_tapes_load(b->file, &b->st), STORED_TAPES_OK);
-    assert_int_equal(b->st.count, b->sc->nsurfaces);
-    assert_int_equal(exact_scene_init(&b->es, b->tree, b->st.tapes, depth), 0);
-}
-
-static void built_free(built *b)
-{
-    exact_scene_free(&b->es);
-    stored_tapes_free(&b->st);
-    oct_close(b->file);
-    free(b->bytes);
-    scene_free(b->sc);
-}
+#include "tests/exact_built.h"
 
 static void look(camera *cam, const double eye[3], const double target[3], uint32_t size)
 {
@@ -86,7 +31,7 @@ static void look(camera *cam, const double eye[3], const double target[3], uint3
 }
 
 /* --exact image (depth, float normals) through frame_render, beam on or off */
-static void render_exact(const built *b, const camera *cam, unsigned beam, float *depth,
+static void render_exact(const exact_built *b, const camera *cam, unsigned beam, float *depth,
                          float *nrm)
 {
     const size_t px = (size_t)cam->width * cam->height;
@@ -117,8 +62,8 @@ static void render_exact(const built *b, const camera *cam, unsigned beam, float
 static void check_vs_refcast(const char *text, unsigned levels, const double eye[3],
                              const double target[3], uint32_t size)
 {
-    built b;
-    build(text, levels, EXACT_CELL_DEPTH, &b);
+    exact_built b;
+    exact_built_make(text, levels, EXACT_CELL_DEPTH, &b);
     camera cam;
     look(&cam, eye, target, size);
     const size_t px = (size_t)size * size;
@@ -155,7 +100,7 @@ static void check_vs_refcast(const char *text, unsigned levels, const double eye
     free(rn);
     free(d0);
     free(n0);
-    built_free(&b);
+    exact_built_free(&b);
 }
 
 static const double eye_std[3] = {2.2, 1.6, 1.9}, centre[3] = {0, 0, 0};
@@ -211,8 +156,8 @@ static void test_undefined_vs_refcast(void **state)
 static void test_impls_agree(void **state)
 {
     (void)state;
-    built b;
-    build("bounds -1 -1 -1 1 1 1\n"
+    exact_built b;
+    exact_built_make("bounds -1 -1 -1 1 1 1\n"
           "surface (x-0.2)^2 + y^2 + z^2 - 0.25\nsurface (x+0.2)^2 + y^2 + z^2 - 0.25\n",
           6, 3, &b);
     exact_worker w;
@@ -261,7 +206,7 @@ static void test_impls_agree(void **state)
     assert_true(hits > 200);
     refcast_scratch_free(rw);
     exact_worker_free(&w);
-    built_free(&b);
+    exact_built_free(&b);
 }
 
 /* Roots on the grid planes: x = 0 is the face between voxels 31 and 32 at
@@ -270,8 +215,8 @@ static void test_impls_agree(void **state)
 static void test_roots_on_faces(void **state)
 {
     (void)state;
-    built b;
-    build("bounds -1 -1 -1 1 1 1\nsurface x\nsurface y - 0.25\n", 6,
+    exact_built b;
+    exact_built_make("bounds -1 -1 -1 1 1 1\nsurface x\nsurface y - 0.25\n", 6,
           EXACT_CELL_DEPTH, &b);
     exact_worker w;
     assert_int_equal(exact_worker_init(&w, &b.es), 0);
@@ -298,7 +243,7 @@ static void test_roots_on_faces(void **state)
         assert_true(h.hit && h.surface == 1 && h.t == 1.75);
     }
     exact_worker_free(&w);
-    built_free(&b);
+    exact_built_free(&b);
 }
 
 /* The fast path (render/exact_fast.c) against the fallback alone (the
@@ -317,8 +262,8 @@ static void test_roots_on_faces(void **state)
  * centre (aimed at distances 0.8 (1 + 2^-k) from it). */
 static void fast_vs_fallback(const char *text, const double target[3], double min_fast)
 {
-    built b;
-    build(text, 7, EXACT_CELL_DEPTH, &b);
+    exact_built b;
+    exact_built_make(text, 7, EXACT_CELL_DEPTH, &b);
     exact_scene off = b.es;
     off.sub_max = 0; /* no sub-cells either */
     off.cand = malloc(b.es.ncand * sizeof *off.cand + 1);
@@ -404,7 +349,7 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
     exact_worker_free(&w1);
     exact_worker_free(&w2);
     free(off.cand);
-    built_free(&b);
+    exact_built_free(&b);
 }
 
 static void test_fast_vs_fallback(void **state)
@@ -439,8 +384,8 @@ static void test_cells_prune(void **state)
         strcat(text, term);
     }
     strcat(text, "0 - 0.5\nsurface (x-0.9)^2 + (y-0.9)^2 + (z-0.9)^2 - 0.0025\n");
-    built b;
-    build(text, 6, 4, &b);
+    exact_built b;
+    exact_built_make(text, 6, 4, &b);
     assert_int_equal(b.es.depth, 4);
     assert_true(b.es.ncells > 0 && b.es.ncand >= b.es.ncells);
     /* every cell has one candidate at most here: the blobs and the small
@@ -455,7 +400,7 @@ static void test_cells_prune(void **state)
     assert_true(b.es.pruned_insns * 2 < b.es.whole_insns);
     /* the culling tapes, pruned with the rasterizer's threshold, are shorter still */
     assert_true(b.es.cull_insns < b.es.pruned_insns);
-    built_free(&b);
+    exact_built_free(&b);
 }
 
 int main(void)
