@@ -56,6 +56,26 @@ int trace_eye_init(const oct_tree *tree, const double eye[3], trace_eye *e)
     return 1;
 }
 
+/* The per-axis part of a direction d (in grid units): 1/d, sign and d, with 1,
+ * +1 and 0 on an axis whose reciprocal is not finite; returns the mask of the
+ * other (active) axes. One place for trace_setup_eye's, trace_dir_init's and
+ * setup_inside's rule. */
+static inline unsigned dir_axes(const double d[3], double inv_out[3], int32_t sgn[3],
+                                double d_out[3])
+{
+    unsigned active = 0;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const double inv = 1.0 / d[a];
+        const int act = fabs(inv) <= DBL_MAX;
+        active |= (unsigned)act << a;
+        inv_out[a] = act ? inv : 1.0;
+        sgn[a] = act && d[a] < 0.0 ? -1 : 1;
+        d_out[a] = act ? d[a] : 0.0;
+    }
+    return active;
+}
+
 /* trace_setup_eye from an eye inside the root cube (the start of secondary
  * rays): there every axis' slab entry time is <= 0, so the ray is never
  * re-based, and its slab exit time is the root exit time T(n or 0) the
@@ -70,21 +90,16 @@ static int setup_inside(const trace_eye *e, const double dir[3], trace_ray *r)
         d[a] = dir[a] * scale;
     if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
         return 0;
-    unsigned active = 0;
+    const unsigned active = dir_axes(d, r->inv, r->sgn, r->d);
     double t_end = INFINITY;
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        const double inv = 1.0 / d[a];
-        const int act = fabs(inv) <= DBL_MAX;
-        active |= (unsigned)act << a;
-        r->inv[a] = act ? inv : 1.0;
-        r->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
-        r->d[a] = act ? d[a] : 0.0;
+        const int act = active >> a & 1u;
         r->o[a] = e->o[a];
         r->ot[a] = act ? e->o[a] : -INFINITY;
         r->v[a] = act ? 0u : floor_clamp(e->o[a], 0, e->nvox - 1);
         if (act) {
-            const double te = (d[a] < 0.0 ? e->lo[a] : e->hi[a]) * inv;
+            const double te = (d[a] < 0.0 ? e->lo[a] : e->hi[a]) * r->inv[a];
             if (te < t_end)
                 t_end = te;
         }
@@ -111,7 +126,6 @@ void trace_dir_init(const trace_eye *e, const double dir[3], trace_dir *td)
 {
     const double scale = e->scale;
     double d[3];
-    unsigned active = 0;
     for (int a = 0; a < 3; a++) {
         td->dir[a] = dir[a];
         d[a] = dir[a] * scale;
@@ -120,14 +134,7 @@ void trace_dir_init(const trace_eye *e, const double dir[3], trace_dir *td)
     td->ok = 0;
     if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
         return;
-    for (int a = 0; a < 3; a++) { /* setup_inside's per-axis part */
-        const double inv = 1.0 / d[a];
-        const int act = fabs(inv) <= DBL_MAX;
-        active |= (unsigned)act << a;
-        td->inv[a] = act ? inv : 1.0;
-        td->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
-        td->d[a] = act ? d[a] : 0.0;
-    }
+    const unsigned active = dir_axes(d, td->inv, td->sgn, td->d);
     td->active = active;
     td->ok = active != 0;
 }
@@ -182,16 +189,7 @@ int trace_setup_eye_general(const trace_eye *e, const double dir[3], trace_ray *
         d[a] = dir[a] * scale;
     if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
         return 0;
-    unsigned active = 0;
-#pragma GCC unroll 3
-    for (int a = 0; a < 3; a++) {
-        const double inv = 1.0 / d[a];
-        const int act = fabs(inv) <= DBL_MAX;
-        active |= (unsigned)act << a;
-        r->inv[a] = act ? inv : 1.0;
-        r->sgn[a] = act && d[a] < 0.0 ? -1 : 1;
-        r->d[a] = act ? d[a] : 0.0;
-    }
+    const unsigned active = dir_axes(d, r->inv, r->sgn, r->d);
     if (!active)
         return 0;
     r->active = active;
