@@ -198,13 +198,16 @@ if has images; then
     echo "Images people want to look at (issue 15): \`blobs_a\`, standard view, against one ray a pixel;"
     echo "rays a second of each kind over thread time (\`render -v\`). Targets: \`--aa 4\` and \`--shadows\`"
     echo "at most 1.6x the time of one ray a pixel, \`--ao 16\` at most 8x; shadow and AO rays at no less"
-    echo "than half the primary rate (✓ met, ✗ not met):"
+    echo "than half the primary rate, the higher of the row's own and the plain run's (✓ met, ✗ not met):"
     echo
     echo "| option | levels | size | ms | time / plain (target) | supersampled % | primary Mrays/s | shadow Mrays/s (≥ ½ primary) | AO Mrays/s (≥ ½ primary) |"
     echo "|---|---|---|---|---|---|---|---|---|"
     awk -F, "$AWKLIB"'
     function rate(x, p) { return x == "" ? "-" : sprintf("%.2f%s", x, mark(x >= p / 2)) }
+    # the plain row comes first; a row with --exact has a lower primary rate of its own
+    NR == 2 { p0 = $13 }
     NR > 1 {
+        p = $13 > p0 ? $13 : p0
         o = $9; tg = ""
         if (o == "plain") o = "one ray a pixel"
         else if (o == "aa") { o = "--aa 4"; tg = 1.6 }
@@ -215,7 +218,7 @@ if has images; then
         r = sprintf("%.2f", $11); if (tg != "") r = r mark($11 <= tg) " (≤ " tg ")"
         sec = ($14 == "" && $15 == "" && $16 != "") ? " (shadow + AO: " sprintf("%.2f", $16) ")" : ""
         printf "| %s | %d | %d² | %.1f | %s | %s | %s | %s | %s%s |\n", o, $7, $8, $10, r, num("%.2f", $12),
-            num("%.2f", $13), rate($14, $13), rate($15, $13), sec
+            num("%.2f", $13), rate($14, p), rate($15, p), sec
     }' "$RES/images.csv"
     echo
     echo "| plain | --aa 4 | --shadows | --ao 16 | all, with --exact |"
