@@ -16,8 +16,6 @@
                                  surface is resolved */
 #define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
 
-static int finite3(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
-
 /* Normal and plane offset of a voxel for a surface: guarded Newton
  * steps from the centre towards f = 0, kept inside the voxel; the normal is
  * the normalised gradient there, the offset the signed distance (in voxel
@@ -72,12 +70,12 @@ static uint32_t newton_record(worker *wk, const newton *nw, const double centre[
     memcpy(p, nw->p, sizeof p);
     memcpy(g, nw->g, sizeof g);
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g) || !isfinite(f)) {
+    if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f)) { /* g2 finite: so is each g[k] */
         memcpy(p, centre, sizeof p);
         f = nw->fg[0];
         memcpy(g, nw->fg + 1, sizeof g);
         g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g)) {
+        if (!(g2 > 0.0) || !isfinite(g2)) {
             wk->st.normal_fallbacks++;
             static const double up[3] = {0.0, 0.0, 1.0};
             return oct_voxel_pack(up, 0.0);
@@ -170,24 +168,29 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
  * symmetrised. 0 when an axis has no such pair or a value is not finite. */
 static int leaf_hessian(const double *fg, unsigned have, const child_boxes *cb, double H[3][3])
 {
+    /* the lower child of each pair along axis k, in increasing order */
+    static const uint8_t lower[3][4] = {{0, 2, 4, 6}, {0, 1, 4, 5}, {0, 1, 2, 3}};
     double D[3][3];
     for (unsigned k = 0; k < 3; k++) {
         const unsigned bk = 1u << k;
+        /* every pair's centres differ along k by the two halves' middles */
+        const double dx = cb->mid[k][1] - cb->mid[k][0];
+        double d[3] = {0.0, 0.0, 0.0};
         unsigned pairs = 0;
-        D[0][k] = D[1][k] = D[2][k] = 0.0;
-        for (unsigned a = 0; a < 8; a++) {
-            const unsigned b = a | bk;
-            if ((a & bk) || !((have >> a) & (have >> b) & 1u))
+        for (unsigned q = 0; q < 4; q++) {
+            const unsigned lo = lower[k][q], hi = lo | bk;
+            if (!((have >> lo) & (have >> hi) & 1u))
                 continue;
-            const double dx = cb->centre[b][k] - cb->centre[a][k];
-            for (unsigned r = 0; r < 3; r++)
-                D[r][k] += (fg[4 * b + 1 + r] - fg[4 * a + 1 + r]) / dx;
+            const double *ga = fg + 4 * lo + 1, *gb = fg + 4 * hi + 1;
+            d[0] += (gb[0] - ga[0]) / dx;
+            d[1] += (gb[1] - ga[1]) / dx;
+            d[2] += (gb[2] - ga[2]) / dx;
             pairs++;
         }
         if (!pairs)
             return 0;
         for (unsigned r = 0; r < 3; r++)
-            D[r][k] /= (double)pairs;
+            D[r][k] = d[r] / (double)pairs;
     }
     for (unsigned r = 0; r < 3; r++)
         for (unsigned k = 0; k < 3; k++) {
