@@ -251,6 +251,22 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3]);
 void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child, const uint8_t *surf,
                  newton *nw, unsigned np);
 
+/* One leaf-parent of a single-surface batch for batch_records: its
+ * children's boxes (made for the children kept), the children kept (keep),
+ * f and grad f at their centres (child i at cf8[4 i]), and the children whose
+ * values may give second differences (have; 0 on a tape with a kink). */
+typedef struct leaf_voxels {
+    const child_boxes *cb;
+    const double *cf8;
+    uint8_t keep, have;
+} leaf_voxels;
+
+/* The records of the voxels of nb leaf-parents of a single-surface scene,
+ * appended leaf-parent by leaf-parent, each in child order: what
+ * emit_voxels makes of each, with the Newton evaluations of all of them
+ * pooled into passes of TAPE_LANES points. At most 8 leaf-parents. */
+void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb);
+
 /* --- the recursion (subdivide.c) ---------------------------------------- */
 
 /* Builds the subtree of task cell `task` (Morton code at the task depth)

@@ -271,10 +271,11 @@ static void push_mask(worker *wk, unsigned depth, uint8_t mask)
     }
 }
 
-/* --shell-only: what visit_children makes of a leaf-parent of a
- * single-surface batch whose form was available (p->ok), without its
- * per-child bookkeeping: the children the form and the re-tests left are
- * its voxels, each an empty record, and its mask. */
+/* What visit_children makes of a leaf-parent of a single-surface batch
+ * whose form was available (p->ok), without its per-child bookkeeping: the
+ * children the form and the re-tests left are its voxels (returned, the
+ * drops counted). With --shell-only each goes out as an empty record here;
+ * otherwise their records are made by batch_records. */
 static unsigned bits8(uint8_t m)
 {
     unsigned n = 0;
@@ -283,15 +284,14 @@ static unsigned bits8(uint8_t m)
     return n;
 }
 
-static uint8_t shell_voxels(worker *wk, const leaf_parent *p)
+static uint8_t kept_voxels(worker *wk, const leaf_parent *p)
 {
     static const uint32_t empty[8];
-    unsigned form_drops = 0;
-    for (unsigned i = 0; i < 8; i++)
-        form_drops += (p->fx[0] >> i) & 1;
     uint8_t keep = (uint8_t)(p->cand & ~(p->centred[0] | p->plain[0]));
+    wk->st.taylor_drops += bits8(p->fx[0]) + bits8(p->centred[0]);
+    if (!wk->c->par->shell_only)
+        return keep;
     unsigned n = bits8(keep);
-    wk->st.taylor_drops += form_drops + bits8(p->centred[0]);
     if (n && buf_push(&wk->out->voxels, empty, n * sizeof *empty)) {
         wk->failed = 1;
         return 0;
@@ -411,28 +411,37 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
     batch_retests(wk, pidx, lp, nb);
     double *cf8 = wk->cf8;
     uint8_t mask = 0;
+    leaf_voxels lv[8]; /* leaf-parents whose records are pending, in order */
+    unsigned nl = 0;
     for (unsigned b = 0; b < nb && !wk->failed; b++) {
         leaf_parent *p = &lp[b];
-        if (c->par->shell_only && p->ok[0]) { /* no record: only the mask and the count */
-            uint8_t pm = shell_voxels(wk, p);
-            push_mask(wk, depth, pm);
-            if (pm)
-                mask |= (uint8_t)(1u << p->slot);
-            continue;
+        uint8_t pm;
+        if (p->ok[0]) { /* no per-child bookkeeping: the mask, the records pooled */
+            pm = kept_voxels(wk, p);
+            if (!c->par->shell_only && pm) {
+                leaf_voxels v = {&p->cb, p->cf8, pm, wk->kinked[pidx] ? 0 : p->cf8_have};
+                lv[nl++] = v;
+            }
+        } else {
+            if (nl) /* the records so far first: voxels go out in order */
+                batch_records(wk, lv, nl);
+            nl = 0;
+            memcpy(wk->ncen[pidx], p->pc, sizeof p->pc);
+            wk->grad_ok[pidx] = p->ok[0];
+            wk->act[pidx] = 0;
+            wk->nact[pidx] = 1;
+            wk->cf8 = p->cf8;
+            wk->cf8_have[0] = wk->kinked[pidx] ? 0 : p->cf8_have;
+            pm = visit_children(wk, depth, p->cell, p->ok, p->fx, &p->cb, 1, p->centred,
+                                p->plain, NULL, NULL);
+            wk->cf8 = cf8;
         }
-        memcpy(wk->ncen[pidx], p->pc, sizeof p->pc);
-        wk->grad_ok[pidx] = p->ok[0];
-        wk->act[pidx] = 0;
-        wk->nact[pidx] = 1;
-        wk->cf8 = p->cf8;
-        wk->cf8_have[0] = wk->kinked[pidx] ? 0 : p->cf8_have;
-        uint8_t pm = visit_children(wk, depth, p->cell, p->ok, p->fx, &p->cb, 1, p->centred,
-                                    p->plain, NULL, NULL);
-        wk->cf8 = cf8;
         push_mask(wk, depth, pm);
         if (pm)
             mask |= (uint8_t)(1u << p->slot);
     }
+    if (nl && !wk->failed)
+        batch_records(wk, lv, nl);
     return wk->failed ? 0 : mask;
 }
 

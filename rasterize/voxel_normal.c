@@ -16,8 +16,6 @@
                                  surface is resolved */
 #define HALF_DIAGONAL 0.8660254037844386 /* sqrt(3)/2: farthest a plane can be and still cut a voxel */
 
-static int finite3(const double v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
-
 /* Normal and plane offset of a voxel for a surface: guarded Newton
  * steps from the centre towards f = 0, kept inside the voxel; the normal is
  * the normalised gradient there, the offset the signed distance (in voxel
@@ -72,12 +70,12 @@ static uint32_t newton_record(worker *wk, const newton *nw, const double centre[
     memcpy(p, nw->p, sizeof p);
     memcpy(g, nw->g, sizeof g);
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g) || !isfinite(f)) {
+    if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f)) { /* g2 finite: so is each g[k] */
         memcpy(p, centre, sizeof p);
         f = nw->fg[0];
         memcpy(g, nw->fg + 1, sizeof g);
         g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if (!(g2 > 0.0) || !isfinite(g2) || !finite3(g)) {
+        if (!(g2 > 0.0) || !isfinite(g2)) {
             wk->st.normal_fallbacks++;
             static const double up[3] = {0.0, 0.0, 1.0};
             return oct_voxel_pack(up, 0.0);
@@ -163,33 +161,36 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
     return push_voxel(wk, newton_record(wk, &nw, centre, h), best);
 }
 
-/* A finite-difference Hessian of surface s over a leaf-parent, shared by
- * its voxels, from the gradients at its children's centres (wk->cf8, the
- * children set in wk->cf8_have): column k the mean of the differences over
- * the pairs of children that differ in bit k alone, then symmetrised. 0 when
- * an axis has no such pair or a value is not finite. */
-static int leaf_hessian(const worker *wk, unsigned s, const child_boxes *cb, double H[3][3])
+/* A finite-difference Hessian over a leaf-parent, shared by its voxels,
+ * from the gradients at its children's centres (fg: f and grad f of child
+ * i at fg[4 i], for the children set in have): column k the mean of the
+ * differences over the pairs of children that differ in bit k alone, then
+ * symmetrised. 0 when an axis has no such pair or a value is not finite. */
+static int leaf_hessian(const double *fg, unsigned have, const child_boxes *cb, double H[3][3])
 {
-    const double *fg = wk->cf8 + (size_t)s * 32;
-    const unsigned have = wk->cf8_have[s];
+    /* the lower child of each pair along axis k, in increasing order */
+    static const uint8_t lower[3][4] = {{0, 2, 4, 6}, {0, 1, 4, 5}, {0, 1, 2, 3}};
     double D[3][3];
     for (unsigned k = 0; k < 3; k++) {
         const unsigned bk = 1u << k;
+        /* every pair's centres differ along k by the two halves' middles */
+        const double dx = cb->mid[k][1] - cb->mid[k][0];
+        double d[3] = {0.0, 0.0, 0.0};
         unsigned pairs = 0;
-        D[0][k] = D[1][k] = D[2][k] = 0.0;
-        for (unsigned a = 0; a < 8; a++) {
-            const unsigned b = a | bk;
-            if ((a & bk) || !((have >> a) & (have >> b) & 1u))
+        for (unsigned q = 0; q < 4; q++) {
+            const unsigned lo = lower[k][q], hi = lo | bk;
+            if (!((have >> lo) & (have >> hi) & 1u))
                 continue;
-            const double dx = cb->centre[b][k] - cb->centre[a][k];
-            for (unsigned r = 0; r < 3; r++)
-                D[r][k] += (fg[4 * b + 1 + r] - fg[4 * a + 1 + r]) / dx;
+            const double *ga = fg + 4 * lo + 1, *gb = fg + 4 * hi + 1;
+            d[0] += (gb[0] - ga[0]) / dx;
+            d[1] += (gb[1] - ga[1]) / dx;
+            d[2] += (gb[2] - ga[2]) / dx;
             pairs++;
         }
         if (!pairs)
             return 0;
         for (unsigned r = 0; r < 3; r++)
-            D[r][k] /= (double)pairs;
+            D[r][k] = d[r] / (double)pairs;
     }
     for (unsigned r = 0; r < 3; r++)
         for (unsigned k = 0; k < 3; k++) {
@@ -219,6 +220,64 @@ static void model_at_iterate(newton *nw, const double c[3], const double H[3][3]
         nw->g[r] = nw->fg[1 + r] + Hd[r];
 }
 
+/* A voxel's first step towards its record, its iteration started at the
+ * centre: with a Hessian H of the leaf-parent (H not NULL), the first Newton
+ * step however short, then the model there (no evaluation, nothing more to
+ * do: 0); without, newton_advance (1 when an evaluation is wanted). */
+static int newton_first(newton *nw, const interval box[3], const double centre[3], double h,
+                        const double (*H)[3])
+{
+    if (!H)
+        return newton_advance(nw, box, h);
+    double q[3];
+    if (newton_target(nw, box, q) >= 0.0) {
+        memcpy(nw->p, q, sizeof q);
+        nw->step++;
+    }
+    model_at_iterate(nw, centre, H);
+    return 0;
+}
+
+#define ROUND_MAX 64 /* voxels of a leaf_batch: 8 leaf-parents of 8 */
+
+/* The Newton iterations w[j] (boxes box[j]) on tape t that still move
+ * (live[j]), to their end: each round evaluates all of them that moved,
+ * TAPE_LANES at a time (tape_eval_grad_lanes, so each gets the bits of its
+ * own evaluation whoever shares the pass). n <= ROUND_MAX. */
+static void newton_rounds(worker *wk, const tape *t, newton *const *w,
+                          const interval *const *box, uint8_t *live, unsigned n, double h)
+{
+    for (;;) {
+        unsigned m = 0, idx[ROUND_MAX];
+        for (unsigned j = 0; j < n; j++)
+            if (live[j])
+                idx[m++] = j;
+        if (!m)
+            return;
+        for (unsigned a = 0; a < m; a += TAPE_LANES) {
+            unsigned k = m - a < TAPE_LANES ? m - a : TAPE_LANES;
+            double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+            for (unsigned l = 0; l < k; l++) {
+                const newton *v = w[idx[a + l]];
+                x[l] = v->p[0];
+                y[l] = v->p[1];
+                z[l] = v->p[2];
+            }
+            tape_eval_grad_lanes(t, k, x, y, z, f, g, wk->lslots);
+            wk->st.point_evals += k;
+            for (unsigned l = 0; l < k; l++) {
+                unsigned j = idx[a + l];
+                newton *v = w[j];
+                v->f = f[l];
+                v->g[0] = g[0][l];
+                v->g[1] = g[1][l];
+                v->g[2] = g[2][l];
+                live[j] = (uint8_t)newton_advance(v, box[j], h);
+            }
+        }
+    }
+}
+
 void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
                  const uint8_t *surf, newton *nw, unsigned np)
 {
@@ -235,47 +294,61 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
     for (unsigned j = 0; j < np; j++) {
         if ((int)surf[j] != hs) {
             hs = surf[j];
-            have_h = leaf_hessian(wk, surf[j], cb, H);
+            have_h = leaf_hessian(wk->cf8 + (size_t)surf[j] * 32, wk->cf8_have[surf[j]], cb, H);
         }
-        if (!have_h) {
-            live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
-            continue;
-        }
-        /* the first step, however short, then the model: no evaluation */
-        double q[3];
-        if (newton_target(&nw[j], cb->box[child[j]], q) >= 0.0) {
-            memcpy(nw[j].p, q, sizeof q);
-            nw[j].step++;
-        }
-        model_at_iterate(&nw[j], cb->centre[child[j]], H);
-        live[j] = 0;
+        live[j] = (uint8_t)newton_first(&nw[j], cb->box[child[j]], cb->centre[child[j]], h,
+                                        have_h ? (const double (*)[3])H : NULL);
     }
-    for (;;) {
-        unsigned first = 0;
-        while (first < np && !live[first])
-            first++;
-        if (first == np)
-            break;
-        unsigned s = surf[first], n = 0, lane[8];
-        double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
-        for (unsigned j = first; j < np; j++)
+    for (unsigned j0 = 0; j0 < np; j0++) { /* surface by surface, those still moving */
+        if (!live[j0])
+            continue;
+        const unsigned s = surf[j0];
+        newton *w[8];
+        const interval *box[8];
+        uint8_t lv[8];
+        unsigned n = 0;
+        for (unsigned j = j0; j < np; j++)
             if (live[j] && surf[j] == s) {
-                x[n] = nw[j].p[0];
-                y[n] = nw[j].p[1];
-                z[n] = nw[j].p[2];
-                lane[n++] = j;
+                w[n] = &nw[j];
+                box[n] = cb->box[child[j]];
+                lv[n++] = 1;
+                live[j] = 0;
             }
-        tape_eval_grad_lanes(c->full[s], n, x, y, z, f, g, wk->lslots);
-        wk->st.point_evals += n;
-        for (unsigned l = 0; l < n; l++) {
-            newton *w = &nw[lane[l]];
-            w->f = f[l];
-            w->g[0] = g[0][l];
-            w->g[1] = g[1][l];
-            w->g[2] = g[2][l];
-            live[lane[l]] = (uint8_t)newton_advance(w, cb->box[child[lane[l]]], h);
-        }
+        newton_rounds(wk, c->full[s], w, box, lv, n, h);
     }
     for (unsigned j = 0; j < np && !wk->failed; j++)
         push_voxel(wk, newton_record(wk, &nw[j], cb->centre[child[j]], h), surf[j]);
+}
+
+void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
+{
+    const build_ctx *c = wk->c;
+    double h = c->cell_edge[c->levels];
+    newton nw[ROUND_MAX], *w[ROUND_MAX];
+    const interval *box[ROUND_MAX];
+    const double *centre[ROUND_MAX];
+    uint8_t live[ROUND_MAX];
+    unsigned n = 0, any = 0;
+    for (unsigned b = 0; b < nb; b++) {
+        double H[3][3];
+        const leaf_voxels *v = &lv[b];
+        if (!v->keep)
+            continue;
+        int have_h = leaf_hessian(v->cf8, v->have, v->cb, H);
+        for (unsigned i = 0; i < 8; i++) {
+            if (!((v->keep >> i) & 1))
+                continue;
+            newton_start(&nw[n], v->cb->centre[i], v->cf8 + 4 * i);
+            w[n] = &nw[n];
+            box[n] = v->cb->box[i];
+            centre[n] = v->cb->centre[i];
+            live[n] = (uint8_t)newton_first(&nw[n], box[n], centre[n], h,
+                                            have_h ? (const double (*)[3])H : NULL);
+            any |= live[n++];
+        }
+    }
+    if (any)
+        newton_rounds(wk, c->full[0], w, box, live, n, h);
+    for (unsigned j = 0; j < n && !wk->failed; j++)
+        push_voxel(wk, newton_record(wk, &nw[j], centre[j], h), 0);
 }
