@@ -43,7 +43,8 @@ static int grow(void **p, size_t *cap, size_t need, size_t size)
 
 void exact_scene_box(const exact_scene *es, unsigned d, const uint32_t c[3], interval box[3])
 {
-    const double m = 0x1p-8, size = ldexp(1.0, (int)(es->tree->levels - d));
+    /* (2^(levels - d) exactly, without a libm call: this runs per sub-cell) */
+    const double m = 0x1p-8, size = (double)(UINT64_C(1) << (es->tree->levels - d));
     for (int a = 0; a < 3; a++) {
         const double lo = es->tree->origin[a] + ((double)c[a] * size - m) * es->h;
         const double hi = es->tree->origin[a] + ((double)(c[a] + 1) * size + m) * es->h;
@@ -125,7 +126,15 @@ static int add_cell(builder *b, const uint32_t c[3])
             return -1;
         /* (k->t's arrays are still those tape_prune_const wrote, or t's) */
         tape_hess_mags(&k->t, box, b->hslots, k->hmag, k->hbranch);
-        k->kinks = tape_hess_kinks(&k->t, box, b->kslots);
+        /* the kinks from t's evaluation above (k->t is t, or t pruned with
+         * those slots and b->tmp_scratch); a flagged one, rare, again */
+        if (flags)
+            k->kinks = tape_hess_kinks(&k->t, box, b->kslots);
+        else
+            k->kinks = tape_prune_kinks(t, b->slots,
+                                        b->off[es->ncand].exact[0] == UINT64_MAX ? NULL
+                                                                                 : b->tmp_scratch,
+                                        &k->t);
         if (store_pruned(b, t, flags, 1e-3 * per_voxel, &k->cull, b->off[es->ncand].cull,
                          &es->cull_insns))
             return -1;
@@ -303,7 +312,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         const tape *t_exact = &c->t, *t_cull = &c->cull;
         const double *hmag = c->hmag;
         uint64_t key = 0;
-        if (!(hmag[0] < INFINITY) && es->sub_max && (c->kinks & EXACT_SUB_KINKS)) {
+        if (!(hmag[0] < INFINITY) && es->sub_max && exact_sub_wanted(c->kinks)) {
             const exact_region *rg = exact_sub_find(&w->sub, es, k, v);
             if (rg->empty) {
                 w->fast++;

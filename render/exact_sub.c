@@ -160,7 +160,9 @@ static uint32_t make_node(exact_sub_cache *c, const exact_scene *es, const exact
         /* the cell's bound with kinks allowed holds where none is left (the
          * cheap way); without one (f may be undefined in the cell), the
          * sub-cell's own enclosure */
-        nd->kinks = tape_hess_kinks(&q, box, c->islots);
+        /* (from p's evaluation above; a flagged one, rare, again on q) */
+        nd->kinks = flags ? tape_hess_kinks(&q, box, c->islots)
+                          : tape_prune_kinks(p, c->islots, c->tmp_mark, &q);
         if (!(cd->hbranch[0] < INFINITY))
             tape_hess_mag(&q, box, c->hslots, nd->hmag);
         else if (!nd->kinks)
@@ -199,7 +201,7 @@ static int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const u
     out->depth = D;
     for (int a = 0; a < 3; a++)
         out->corner[a] = v[a] >> (L - D);
-    if (!es->sub_max || cd->hmag[0] < INFINITY || !(cd->kinks & EXACT_SUB_KINKS))
+    if (!es->sub_max || cd->hmag[0] < INFINITY || !exact_sub_wanted(cd->kinks))
         return 0;
     uint32_t owner = NONE; /* the node whose block is searched; NONE: the candidate's */
     tape p = cd->t;
@@ -228,10 +230,10 @@ static int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const u
             c->block[(size_t)b * FAN + idx] = i;
         }
         const exact_sub_node *nd = &c->node[i];
-        /* (deeper only while a min/max or a flag is in the way: see
-         * EXACT_SUB_KINKS) */
+        /* (deeper only while a min/max or a flag is in the way and no abs:
+         * see exact_sub_wanted) */
         if (nd->empty || nd->hmag[0] < INFINITY || r >= es->sub_max ||
-            !(nd->kinks & EXACT_SUB_KINKS)) {
+            !exact_sub_wanted(nd->kinks)) {
             const uint64_t key = (uint64_t)r << 60 | (uint64_t)cc[2] << 40 |
                                  (uint64_t)cc[1] << 20 | cc[0];
             region_of(out, cd, nd, key);

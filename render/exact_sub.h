@@ -20,11 +20,18 @@
 struct exact_scene;
 
 /* The kinks (tape_hess_kinks) sub-cells are made for: a min/max's
- * operands separate a little away from its crease, and a flag may go; an
- * abs of an operand that vanishes inside the cell (the gyroid's |G|, whose
- * zero set runs a few voxels from the surface) seldom separates in the
- * first levels, each a pruning more (docs/perf-log.md). */
+ * operands separate a little away from its crease, and a flag may go. An
+ * abs of an operand that vanishes inside the (sub-)cell, left there by the
+ * pruning (the gyroid's |G|, whose zero set runs a few voxels from the
+ * surface), seldom separates in the first levels, each a pruning more: a
+ * region whose tape still has one gets no sub-cells, whatever else is
+ * kinked there (docs/perf-log.md). The rule reads the region's own kink
+ * mask, so it depends on the region alone. */
 #define EXACT_SUB_KINKS (TAPE_KINK_MINMAX | TAPE_KINK_FLAG)
+static inline int exact_sub_wanted(unsigned kinks)
+{
+    return (kinks & EXACT_SUB_KINKS) && !(kinks & TAPE_KINK_ABS);
+}
 
 #define EXACT_SUB_STEP 2    /* depths from a level to the next: 8^2 sub-cells */
 #define EXACT_SUB_MAX_REL 8 /* deepest sub-cell: coarse depth + this */

@@ -186,7 +186,12 @@ static void test_sub_cells(void **state)
                    " instructions %llu -> %llu\n",
                    s, n.sub_finite, n.sub_inf, n.empty, n.points, n.entries,
                    (unsigned long long)n.cell_n, (unsigned long long)n.sub_n);
-        /* (the gyroid's abs-only cells keep the fallback: EXACT_SUB_KINKS) */
+        if (strstr(kinked[s], "sin(")) {
+            /* the gyroid: its cells keep an abs of an operand that changes
+             * sign there, so none gets sub-cells (exact_sub_wanted) */
+            assert_int_equal(n.sub_finite + n.sub_inf + n.empty, 0);
+            continue;
+        }
         assert_true(n.sub_finite > 50);
         assert_true(n.entries > 1000);
         assert_true(n.sub_n < n.cell_n); /* the pruned tapes are shorter */

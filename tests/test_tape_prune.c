@@ -1,7 +1,8 @@
 /* Tests for common/expr/tape on random expression trees and for the
  * pruner: interval enclosures of random trees and agreement of their
  * pruned tapes, tape_prune on a known min/max, tape_prune_const's
- * soundness and what it drops. */
+ * soundness and what it drops, tape_prune_kinks against tape_hess_kinks of
+ * the pruned tape. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +16,7 @@
 
 #include "common/expr/scene.h"
 #include "common/expr/tape.h"
+#include "common/expr/tape_hess.h"
 #include "tests/test_tape_util.h"
 
 static void test_random_trees(void **state)
@@ -127,6 +129,52 @@ static void test_prune_const_stays_sound(void **state)
     assert_true(replaced > 0);
 }
 
+/* tape_prune_kinks (the pruned tape's kinks from the slots it was pruned
+ * with) equals tape_hess_kinks of the pruned tape (its own evaluation), for
+ * tape_prune, tape_prune_const and the tape itself, on random trees and
+ * boxes (the flagged ones are not its case). */
+static void test_prune_kinks(void **state)
+{
+    (void)state;
+    static char text[16384];
+    static interval slots[MAXSLOTS], slots2[MAXSLOTS];
+    static tape_insn pruned_insn[MAXSLOTS];
+    static tape_const pruned_konst[2 * MAXSLOTS];
+    static uint32_t scratch[MAXSLOTS];
+    long checked = 0, kinked = 0, differ = 0;
+    for (int n = 0; n < 3000 / SCALE; n++) {
+        scene *s = rand_tree(text, sizeof text);
+        const tape *t = &s->surfaces[0].tape;
+        for (int b = 0; b < 20; b++) {
+            interval box[3];
+            rand_tree_box(box);
+            unsigned f;
+            const interval r = tape_eval_interval(t, box, slots, &f);
+            if (f)
+                continue;
+            assert_int_equal(tape_prune_kinks(t, slots, NULL, t), tape_hess_kinks(t, box, slots2));
+            tape pt;
+            tape_prune(t, slots, f, pruned_insn, scratch, &pt);
+            const unsigned k1 = tape_prune_kinks(t, slots, scratch, &pt);
+            assert_int_equal(k1, tape_hess_kinks(&pt, box, slots2));
+            const double tiny = 0.05 * (r.hi - r.lo);
+            tape_prune_const(t, slots, f, isfinite(tiny) ? tiny : -1.0, pruned_insn, pruned_konst,
+                             scratch, &pt);
+            const unsigned k2 = tape_prune_kinks(t, slots, scratch, &pt);
+            assert_int_equal(k2, tape_hess_kinks(&pt, box, slots2));
+            checked++;
+            kinked += k1 != 0;
+            differ += k1 != k2;
+        }
+        scene_free(s);
+    }
+    if (getenv("TAPE_VERBOSE"))
+        printf("prune kinks: %ld boxes, %ld kinked, %ld where the constants took one\n", checked,
+               kinked, differ);
+    assert_true(checked > 1000);
+    assert_true(kinked > 100);
+}
+
 /* A far blob over the unit box is a constant to within 1e-40: it goes. */
 static void test_prune_const_drops_far_terms(void **state)
 {
@@ -190,6 +238,7 @@ int main(void)
         cmocka_unit_test(test_prune),
         cmocka_unit_test(test_prune_const_stays_sound),
         cmocka_unit_test(test_prune_const_drops_far_terms),
+        cmocka_unit_test(test_prune_kinks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

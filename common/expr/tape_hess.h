@@ -58,4 +58,15 @@ void tape_hess_mags(const tape *t, const interval box[3], tape_ihess *slots, dou
 enum { TAPE_KINK_ABS = 1u, TAPE_KINK_MINMAX = 2u, TAPE_KINK_FLAG = 4u };
 unsigned tape_hess_kinks(const tape *t, const interval box[3], interval *slots);
 
+/* tape_hess_kinks of `pruned` over the box without evaluating it again:
+ * `pruned` is what tape_prune or tape_prune_const last wrote from t with
+ * `slots` (t's tape_eval_interval over the box, with flags 0) and `scratch`
+ * (the same array, left as they leave it); scratch NULL: pruned is t
+ * itself. The pruned tape's evaluation over the box gives each instruction
+ * the enclosure t's gave it (a constant holds its slot's enclosure, a
+ * decided min/max's winner is its operand's), so the mask reads those; no
+ * flag, as t's evaluation has none (tape_prune.c). */
+unsigned tape_prune_kinks(const tape *t, const interval *slots, const uint32_t *scratch,
+                          const tape *pruned);
+
 #endif

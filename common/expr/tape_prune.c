@@ -1,6 +1,7 @@
 /* tape_prune: dead-code removal and pruning of a tape for a box, from the
  * interval enclosures of its slots over that box. */
 #include "common/expr/tape.h"
+#include "common/expr/tape_hess.h"
 
 #include <string.h>
 
@@ -115,4 +116,33 @@ uint32_t tape_prune_const(const tape *t, const interval *slots, unsigned flags, 
     out->nconst = nconst;
     out->owned = 0;
     return n;
+}
+
+/* After compact, scratch[i] is the output index of t's instruction i when
+ * it was kept, became a constant, or (a decided min/max) was replaced by
+ * its winner, and EMPTY when dead. Only kept instructions give an output
+ * instruction of their own op: a constant's is TAPE_CONST (never a kept
+ * op), and a replaced min/max whose winner is a min/max too has operands
+ * that separate strictly, which is no kink. */
+unsigned tape_prune_kinks(const tape *t, const interval *slots, const uint32_t *scratch,
+                          const tape *pruned)
+{
+    unsigned kinks = 0;
+    for (uint32_t i = 0; i < t->n; i++) {
+        const tape_insn *in = &t->insn[i];
+        if (in->op != TAPE_ABS && in->op != TAPE_MIN && in->op != TAPE_MAX)
+            continue;
+        if (scratch && (scratch[i] == EMPTY || pruned->insn[scratch[i]].op != in->op))
+            continue;
+        const interval a = slots[in->a];
+        if (in->op == TAPE_ABS) {
+            if (!(a.lo >= 0.0 || a.hi <= 0.0)) /* (tape_hess_kinks' rule) */
+                kinks |= TAPE_KINK_ABS;
+        } else {
+            const interval c = slots[in->b];
+            if (!(a.hi < c.lo || c.hi < a.lo))
+                kinks |= TAPE_KINK_MINMAX;
+        }
+    }
+    return kinks;
 }
