@@ -1,26 +1,39 @@
 /* trace_packet: one depth-first walk of the octree for a packet of rays
- * (see trace_packet.h). Plain C, the same on every target. */
+ * (see trace_packet.h). The lanes' steps through a node in plain C
+ * (node_steps) and, where the target has SSE2, two lanes at a time
+ * (node_steps_sse2): the same values, bit for bit. */
 #include "render/trace_packet.h"
 
 #include <math.h>
 
+#if TRACE_PACKET_HAVE_SSE2
+#include <emmintrin.h>
+#endif
+
 #define LANES TRACE_PACKET_MAX
 
-/* What the walk keeps for the whole packet. Lane s is ray s. */
+/* What the walk keeps for the whole packet. Lane s is ray s; lanes past
+ * the packet's rays hold harmless values (the SSE2 steps read lanes in
+ * pairs). */
 typedef struct packet {
-    double zo[3][LANES], zi[3][LANES]; /* T_a(k) = (k - zo_a) * zi_a */
+    _Alignas(16) double zo[3][LANES];
+    _Alignas(16) double zi[3][LANES]; /* T_a(k) = (k - zo_a) * zi_a */
     double tb[LANES];                  /* t_base */
     const oct_tree *tree;
     trace_hit *hits;
     unsigned levels;
     unsigned flip;  /* bit a: the rays go down axis a (child k ^ flip is k-th in order) */
     uint32_t alive; /* lanes whose voxel is not found yet */
+    int sse2;       /* 1: node_steps_sse2 */
 } packet;
 
 /* The lanes in each child of a node and their intervals there. */
 typedef struct child_lanes {
-    uint32_t lanes[8];
-    double lo[8][LANES], hi[8][LANES];
+    _Alignas(16) double lo[8][LANES];
+    _Alignas(16) double hi[8][LANES];
+    uint32_t lanes[8]; /* node_steps: the lanes in child k */
+    uint32_t pairs;    /* node_steps_sse2: bit 2q for each pair q computed, */
+    uint16_t w[LANES / 2]; /* and its lanes: bit 2k + l for lane 2q + l in child k */
 } child_lanes;
 
 int trace_packet_fits(const trace_ray *r, unsigned n)
@@ -90,6 +103,109 @@ static unsigned node_steps(const packet *p, const uint32_t c[3], uint32_t half,
     return touched;
 }
 
+#if TRACE_PACKET_HAVE_SSE2
+/* node_steps for two lanes at a time, without following each lane's steps:
+ * child k's interval is [L(k), H(k)), L(k) = max(lo, tm of its far axes),
+ * H(k) = min(hi, tm of its near axes), for all eight children from 7 max
+ * and 7 min (each over its axes in increasing order, as node_steps
+ * compares them: _mm_max_pd(t, acc) keeps acc on a tie, _mm_min_pd(t, acc)
+ * too), and a lane is in child k when L(k) < H(k). These are node_steps'
+ * values bit for bit: its entry child's start is lo, each later child's
+ * the exit time of the one before, which is the largest tm of the axes
+ * crossed then (the first of them on a tie, as here); its ends are H(k),
+ * computed in the same order. A lane of a pair outside `live` computes
+ * values no mask lets out (from slots written before: the set-up fills
+ * every lane, and each pair's child slots are written whole). */
+static unsigned node_steps_sse2(const packet *p, const uint32_t c[3], uint32_t half,
+                                const double *nlo, const double *nhi, uint32_t live,
+                                child_lanes *ch)
+{
+    const __m128d km0 = _mm_set1_pd((double)(c[0] + half));
+    const __m128d km1 = _mm_set1_pd((double)(c[1] + half));
+    const __m128d km2 = _mm_set1_pd((double)(c[2] + half));
+    const uint32_t pairs = (live | live >> 1) & UINT32_C(0x55555555);
+    unsigned any = 0;
+    for (uint32_t b = pairs; b; b &= b - 1u) {
+        const unsigned s = (unsigned)__builtin_ctz(b);
+        const __m128d lo = _mm_load_pd(nlo + s), hi = _mm_load_pd(nhi + s);
+        const __m128d t0 = _mm_mul_pd(_mm_sub_pd(km0, _mm_load_pd(&p->zo[0][s])),
+                                      _mm_load_pd(&p->zi[0][s]));
+        const __m128d t1 = _mm_mul_pd(_mm_sub_pd(km1, _mm_load_pd(&p->zo[1][s])),
+                                      _mm_load_pd(&p->zi[1][s]));
+        const __m128d t2 = _mm_mul_pd(_mm_sub_pd(km2, _mm_load_pd(&p->zo[2][s])),
+                                      _mm_load_pd(&p->zi[2][s]));
+        __m128d L[8], H[8];
+        L[0] = lo;
+        L[1] = _mm_max_pd(t0, lo);
+        L[2] = _mm_max_pd(t1, lo);
+        L[3] = _mm_max_pd(t1, L[1]);
+        L[4] = _mm_max_pd(t2, lo);
+        L[5] = _mm_max_pd(t2, L[1]);
+        L[6] = _mm_max_pd(t2, L[2]);
+        L[7] = _mm_max_pd(t2, L[3]);
+        H[7] = hi;
+        H[6] = _mm_min_pd(t0, hi);
+        H[5] = _mm_min_pd(t1, hi);
+        H[4] = _mm_min_pd(t1, H[6]);
+        H[3] = _mm_min_pd(t2, hi);
+        H[2] = _mm_min_pd(t2, H[6]);
+        H[1] = _mm_min_pd(t2, H[5]);
+        H[0] = _mm_min_pd(t2, H[4]);
+#pragma GCC unroll 8
+        for (unsigned k = 0; k < 8; k++) {
+            _mm_store_pd(&ch->lo[k][s], L[k]);
+            _mm_store_pd(&ch->hi[k][s], H[k]);
+        }
+        /* the eight compare masks to 16 bits, 2k + l, by packing */
+        __m128 cm[8];
+#pragma GCC unroll 8
+        for (unsigned k = 0; k < 8; k++)
+            cm[k] = _mm_castpd_ps(_mm_cmplt_pd(L[k], H[k]));
+        const __m128i p0 = _mm_packs_epi32(
+            _mm_castps_si128(_mm_shuffle_ps(cm[0], cm[1], _MM_SHUFFLE(2, 0, 2, 0))),
+            _mm_castps_si128(_mm_shuffle_ps(cm[2], cm[3], _MM_SHUFFLE(2, 0, 2, 0))));
+        const __m128i p1 = _mm_packs_epi32(
+            _mm_castps_si128(_mm_shuffle_ps(cm[4], cm[5], _MM_SHUFFLE(2, 0, 2, 0))),
+            _mm_castps_si128(_mm_shuffle_ps(cm[6], cm[7], _MM_SHUFFLE(2, 0, 2, 0))));
+        static const uint16_t of_lanes[4] = {0, 0x5555u, 0xaaaau, 0xffffu};
+        const unsigned w = (unsigned)_mm_movemask_epi8(_mm_packs_epi16(p0, p1)) &
+                           of_lanes[live >> s & 3u];
+        ch->w[s >> 1] = (uint16_t)w;
+        any |= w;
+    }
+    ch->pairs = pairs;
+    /* child k is touched when bit 2k or 2k + 1 of `any` is set */
+    unsigned touched = (any | any >> 1) & 0x5555u;
+    touched = (touched | touched >> 1) & 0x3333u;
+    touched = (touched | touched >> 2) & 0x0f0fu;
+    touched = (touched | touched >> 4) & 0x00ffu;
+    return touched;
+}
+
+/* The lanes node_steps_sse2 put in child k. */
+static inline uint32_t pair_lanes(const child_lanes *ch, unsigned k)
+{
+    uint32_t m = 0;
+    for (uint32_t b = ch->pairs; b; b &= b - 1u) {
+        const unsigned s = (unsigned)__builtin_ctz(b);
+        m |= (uint32_t)(ch->w[s >> 1] >> (2u * k) & 3u) << s;
+    }
+    return m;
+}
+#endif
+
+/* The children of mask `m` (bit ci) in the order of `flip` (bit ci ^ flip). */
+static inline unsigned mask_in_order(unsigned m, unsigned flip)
+{
+    if (flip & 1u)
+        m = (m & 0x55u) << 1 | (m >> 1 & 0x55u);
+    if (flip & 2u)
+        m = (m & 0x33u) << 2 | (m >> 2 & 0x33u);
+    if (flip & 4u)
+        m = (m & 0x0fu) << 4 | (m >> 4 & 0x0fu);
+    return m;
+}
+
 /* Node `node` of depth d (corner c, edge size), met by the lanes `live` over
  * [lo, hi) each: its occupied children front to back, each opened for the
  * lanes that pass through it and are still looking; a voxel ends the
@@ -100,19 +216,30 @@ static void visit(packet *p, unsigned d, uint64_t node, const uint32_t c[3], uin
     const oct_children och = oct_node_children(p->tree->groups[d], node);
     const uint32_t half = size >> 1;
     child_lanes ch;
-    for (unsigned k = 0; k < 8; k++)
-        ch.lanes[k] = 0;
-    unsigned todo = node_steps(p, c, half, lo, hi, live, &ch);
+    unsigned todo;
+#if TRACE_PACKET_HAVE_SSE2
+    if (p->sse2) {
+        todo = node_steps_sse2(p, c, half, lo, hi, live, &ch);
+    } else
+#endif
+    {
+        for (unsigned k = 0; k < 8; k++)
+            ch.lanes[k] = 0;
+        todo = node_steps(p, c, half, lo, hi, live, &ch);
+    }
     const int leaf = d + 1 == p->levels;
-    for (; todo; todo &= todo - 1u) {
+    for (todo &= mask_in_order(och.mask, p->flip); todo; todo &= todo - 1u) {
         const unsigned k = (unsigned)__builtin_ctz(todo), ci = k ^ p->flip;
-        if (!(och.mask >> ci & 1u))
-            continue;
+#if TRACE_PACKET_HAVE_SSE2
+        const uint32_t m = (p->sse2 ? pair_lanes(&ch, k) : ch.lanes[k]) & p->alive;
+#else
         const uint32_t m = ch.lanes[k] & p->alive;
+#endif
         if (!m)
             continue;
         const uint64_t idx = och.first + oct_popcount64(och.mask & ((1u << ci) - 1u));
         uint32_t cc[3];
+#pragma GCC unroll 3
         for (unsigned a = 0; a < 3; a++)
             cc[a] = c[a] + ((ci >> a & 1u) ? half : 0u);
         if (leaf) {
@@ -134,7 +261,9 @@ static void visit(packet *p, unsigned d, uint64_t node, const uint32_t c[3], uin
     }
 }
 
-void trace_packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, trace_hit *hits)
+/* The walk, node_steps in SSE2 lanes or not. */
+static void packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, trace_hit *hits,
+                         int sse2)
 {
     for (unsigned k = 0; k < n; k++) {
         hits[k].hit = 0;
@@ -150,14 +279,24 @@ void trace_packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, tr
     p.tree = tree;
     p.hits = hits;
     p.levels = tree->levels;
+    p.sse2 = sse2;
     p.flip = 0;
     for (unsigned k = 0; k < n; k++)
         for (unsigned a = 0; a < 3; a++)
             if (r[k].active >> a & 1u && r[k].sgn[a] < 0)
                 p.flip |= 1u << a;
-    double lo[LANES], hi[LANES];
+    _Alignas(16) double lo[LANES], hi[LANES];
     uint32_t live = 0;
-    for (unsigned s = 0; s < n; s++) {
+    for (unsigned s = 0; s < LANES; s++) {
+        if (s >= n) { /* no ray: finite values, an empty interval */
+            for (unsigned a = 0; a < 3; a++) {
+                p.zo[a][s] = 0.5;
+                p.zi[a][s] = 1.0;
+            }
+            p.tb[s] = 0.0;
+            lo[s] = hi[s] = 0.0;
+            continue;
+        }
         const trace_ray *ray = &r[s];
         for (unsigned a = 0; a < 3; a++) {
             const int act = ray->active >> a & 1u;
@@ -176,4 +315,15 @@ void trace_packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, tr
     const uint32_t corner[3] = {0, 0, 0};
     if (live)
         visit(&p, 0, 0, corner, UINT32_C(1) << p.levels, lo, hi, live);
+}
+
+void trace_packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, trace_hit *hits)
+{
+    packet_first(tree, r, n, hits, TRACE_PACKET_HAVE_SSE2);
+}
+
+void trace_packet_first_portable(const oct_tree *tree, const trace_ray *r, unsigned n,
+                                 trace_hit *hits)
+{
+    packet_first(tree, r, n, hits, 0);
 }

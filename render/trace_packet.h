@@ -26,6 +26,14 @@
 
 #define TRACE_PACKET_MAX 16 /* rays a packet */
 
+/* 1 when trace_packet_first takes each node's steps two lanes at a time
+ * (SSE2); trace_packet_first_portable is the plain C walk, the same bits. */
+#if defined(__SSE2__)
+#define TRACE_PACKET_HAVE_SSE2 1
+#else
+#define TRACE_PACKET_HAVE_SSE2 0
+#endif
+
 /* 1 when rays r[0..n) (n <= TRACE_PACKET_MAX, each from trace_setup or
  * trace_setup_eye, possibly clipped) can share a walk: on every axis their
  * directions agree in sign (a zero axis agrees with either). */
@@ -36,5 +44,9 @@ int trace_packet_fits(const trace_ray *r, unsigned n);
  * 0, the walk takes no DDA steps of its own. Thread-safe (reads the tree
  * only), no allocation. */
 void trace_packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, trace_hit *hits);
+
+/* The same walk in plain C whatever the target (the tests compare it). */
+void trace_packet_first_portable(const oct_tree *tree, const trace_ray *r, unsigned n,
+                                 trace_hit *hits);
 
 #endif

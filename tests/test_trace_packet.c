@@ -4,7 +4,8 @@
  * directions, rays on voxel planes, axis-aligned and zero-component
  * directions and clipped starts; on a sphere's shell with the samples of
  * the pixels along its silhouette (grazing rays); and packets whose
- * directions disagree in sign are refused. */
+ * directions disagree in sign are refused. The walk is checked as the
+ * build takes it (SSE2 steps on x86) and in plain C. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -31,32 +32,50 @@ typedef struct counts {
     unsigned long packets, rays, hits;
 } counts;
 
-/* Each ray of the packet against the traversal of it alone. */
-static void check_packet(const oct_tree *t, const trace_ray *r, unsigned n, counts *c)
+/* The packet walks built: the build's own and the plain C one. */
+typedef void (*packet_fn)(const oct_tree *, const trace_ray *, unsigned, trace_hit *);
+static const packet_fn walks[] = {trace_packet_first, trace_packet_first_portable};
+
+/* One walk's hits for the packet against the traversal's, h[k] for ray k. */
+static void check_walk(const oct_tree *t, packet_fn walk, const trace_ray *r, unsigned n,
+                       const trace_hit *h0)
 {
     trace_hit ph[TRACE_PACKET_MAX];
-    trace_packet_first(t, r, n, ph);
-    const trace_opts plain = {t->levels, 0, NULL};
+    walk(t, r, n, ph);
     for (unsigned k = 0; k < n; k++) {
-        trace_hit h;
-        trace_prepared_all(t, &plain, &r[k], &h);
-        if (h.hit != ph[k].hit || (h.hit && (h.voxel != ph[k].voxel || h.t != ph[k].t ||
-                                             memcmp(h.xyz, ph[k].xyz, sizeof h.xyz) != 0)))
-            print_error("ray %u of %u: o %a %a %a d %a %a %a [%a, %a): traversal %d (%u %u %u) "
-                        "t %a, packet %d (%u %u %u) t %a\n",
-                        k, n, r[k].o[0], r[k].o[1], r[k].o[2], r[k].d[0], r[k].d[1], r[k].d[2],
-                        r[k].t_start, r[k].t_end, h.hit, h.xyz[0], h.xyz[1], h.xyz[2], h.t,
-                        ph[k].hit, ph[k].xyz[0], ph[k].xyz[1], ph[k].xyz[2], ph[k].t);
-        assert_int_equal(ph[k].hit, h.hit);
+        const trace_hit *h = &h0[k];
+        if (h->hit != ph[k].hit || (h->hit && (h->voxel != ph[k].voxel || h->t != ph[k].t ||
+                                               memcmp(h->xyz, ph[k].xyz, sizeof h->xyz) != 0)))
+            print_error("%s walk, ray %u of %u: o %a %a %a d %a %a %a [%a, %a): traversal %d "
+                        "(%u %u %u) t %a, packet %d (%u %u %u) t %a\n",
+                        walk == trace_packet_first ? "build's" : "plain C", k, n, r[k].o[0],
+                        r[k].o[1], r[k].o[2], r[k].d[0], r[k].d[1], r[k].d[2], r[k].t_start,
+                        r[k].t_end, h->hit, h->xyz[0], h->xyz[1], h->xyz[2], h->t, ph[k].hit,
+                        ph[k].xyz[0], ph[k].xyz[1], ph[k].xyz[2], ph[k].t);
+        assert_int_equal(ph[k].hit, h->hit);
         assert_int_equal(ph[k].steps, 0);
         assert_int_equal(ph[k].exact, 0);
-        if (h.hit) {
-            assert_true(ph[k].voxel == h.voxel);
-            assert_true(ph[k].t == h.t);
-            assert_memory_equal(ph[k].xyz, h.xyz, sizeof h.xyz);
+        if (h->hit) {
+            assert_true(ph[k].voxel == h->voxel);
+            assert_true(ph[k].t == h->t);
+            assert_memory_equal(ph[k].xyz, h->xyz, sizeof h->xyz);
         }
+    }
+}
+
+/* Each ray of the packet, by every packet walk, against the traversal of
+ * it alone. */
+static void check_packet(const oct_tree *t, const trace_ray *r, unsigned n, counts *c)
+{
+    trace_hit h[TRACE_PACKET_MAX];
+    const trace_opts plain = {t->levels, 0, NULL};
+    for (unsigned k = 0; k < n; k++)
+        trace_prepared_all(t, &plain, &r[k], &h[k]);
+    for (unsigned wi = 0; wi < sizeof walks / sizeof walks[0]; wi++)
+        check_walk(t, walks[wi], r, n, h);
+    for (unsigned k = 0; k < n; k++) {
         c->rays++;
-        c->hits += (unsigned long)h.hit;
+        c->hits += (unsigned long)h[k].hit;
     }
     c->packets++;
 }
