@@ -451,6 +451,67 @@ static void test_exp_rounding(void **state)
     check_exp_rounding((interval){-INFINITY, INFINITY});
 }
 
+/* Whether [r.lo, r.hi] holds sin (or cos) at x, by MPFR. */
+static int trig_holds(interval r, double x, int is_cos)
+{
+    double rd, ru;
+    exact_at(is_cos ? COS : SIN, x, 0.0, 0.0, &rd, &ru);
+    return r.lo <= rd && ru <= r.hi;
+}
+
+/* interval_sincos: the midpoint form on narrow intervals holds sin and cos
+ * at the ends, the midpoint, random interior points and the extrema inside;
+ * it is no wider than the range's slope bound plus the remainder; each
+ * enclosure is the same with the other pointer NULL; wide or far intervals
+ * get interval_sin's and interval_cos's. */
+static void test_sincos(void **state)
+{
+    (void)state;
+    static const double scale[] = {1.0, 10.0, 1e3, 1e7};
+    static const double width[] = {0.0, 1e-12, 1e-6, 0.01, 0.1, 0.25};
+    for (int n = 0; n < 20000; n++) {
+        double c = (unit() - 0.5) * 2 * scale[n % 4];
+        if (n % 5 == 0) /* near an extremum of sin or cos */
+            c = (double)(long)(c / (M_PI / 2)) * (M_PI / 2) + (unit() - 0.5) * 1e-3;
+        double w = n % 7 == 6 ? unit() * 0.25 : width[n % 6];
+        interval a = {c - w / 2, c + w / 2};
+        if (a.hi - a.lo > 0.25)
+            a.hi = a.lo + 0.25;
+        unsigned f = 0;
+        interval s, co, s1, c1;
+        interval_sincos(a, &s, &co, &f);
+        interval_sincos(a, &s1, NULL, &f);
+        interval_sincos(a, NULL, &c1, &f);
+        assert_int_equal(f, 0);
+        assert_true(s.lo == s1.lo && s.hi == s1.hi && co.lo == c1.lo && co.hi == c1.hi);
+        double h = (a.hi - a.lo) / 2, bound = 2 * h + h * h + 1e-9;
+        if (!(s.hi - s.lo <= bound && co.hi - co.lo <= bound))
+            fail_msg("sincos([%a,%a]) too wide: [%a,%a] [%a,%a]", a.lo, a.hi, s.lo, s.hi, co.lo, co.hi);
+        double pts[8] = {a.lo, a.hi, 0.5 * a.lo + 0.5 * a.hi};
+        int np = 3;
+        for (; np < 6; np++)
+            pts[np] = witness(a, 2);
+        double k = ceil(a.lo / (M_PI / 2)); /* an extremum inside, as a double */
+        if (k * (M_PI / 2) <= a.hi)
+            pts[np++] = k * (M_PI / 2);
+        for (int j = 0; j < np; j++)
+            if (!trig_holds(s, pts[j], 0) || !trig_holds(co, pts[j], 1))
+                fail_msg("sincos([%a,%a]) = [%a,%a] [%a,%a] misses the value at %a", a.lo, a.hi,
+                         s.lo, s.hi, co.lo, co.hi, pts[j]);
+    }
+    static const interval wide[] = {{0.0, 0.5}, {-3.0, 3.0}, {1e9, 1e9}, {-INFINITY, 1.0}};
+    for (size_t j = 0; j < sizeof wide / sizeof wide[0]; j++) {
+        unsigned f = 0, g = 0;
+        interval s, co, s0 = interval_sin(wide[j], &g), c0 = interval_cos(wide[j], &g);
+        interval_sincos(wide[j], &s, &co, &f);
+        assert_true(s.lo == s0.lo && s.hi == s0.hi && co.lo == c0.lo && co.hi == c0.hi && f == g);
+    }
+    unsigned f = 0;
+    interval s, co;
+    interval_sincos(interval_nan(), &s, &co, &f);
+    assert_true(interval_is_nan(s) && interval_is_nan(co) && f == INTERVAL_MAYBE_NAN);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -464,7 +525,7 @@ int main(void)
         cmocka_unit_test(test_sound_max), cmocka_unit_test(test_sound_powc),
         cmocka_unit_test(test_point_box_width), cmocka_unit_test(test_pitfalls),
         cmocka_unit_test(test_exp_rounding), cmocka_unit_test(test_rounding_steps),
-        cmocka_unit_test(test_add_rounding),
+        cmocka_unit_test(test_add_rounding), cmocka_unit_test(test_sincos),
     };
     return cmocka_run_group_tests(tests, mpfr_setup, mpfr_teardown);
 }

@@ -61,6 +61,12 @@ interval interval_log(interval a, unsigned *flags);
  * beyond |1e8|, or 6 wide or more, the result is [-1, 1]. */
 interval interval_sin(interval a, unsigned *flags);
 interval interval_cos(interval a, unsigned *flags);
+/* Enclosures of sin and cos over a (either pointer may be NULL). Up to a
+ * quarter wide, from one sincos at a's midpoint and the second-order
+ * remainder (sound, a little wider than interval_sin's, at a fraction of
+ * its cost); otherwise interval_sin's and interval_cos's. The rasterizer's
+ * and the exact renderer's interval evaluators use this. */
+void interval_sincos(interval a, interval *so, interval *co, unsigned *flags);
 /* tan(a), ends rounded two steps outward. Across a pole, 3 wide or more,
  * or with an end beyond |1e8|, the result is [-inf, inf]. */
 interval interval_tan(interval a, unsigned *flags);

@@ -111,11 +111,21 @@ interval tape_eval_interval_dir(const tape *t, const interval box[3], const doub
             r->d = dmul(a.d, m, &f);
             break;
         }
-        case TAPE_SIN: r->v = interval_sin(a.v, &f); r->d = dmul(a.d, interval_cos(a.v, &f), &f); break;
-        case TAPE_COS:
-            r->v = interval_cos(a.v, &f);
-            r->d = dmul(a.d, interval_neg(interval_sin(a.v, &f)), &f);
+        /* the value as tape_eval_interval makes it (interval_sincos), bit for bit */
+        case TAPE_SIN: {
+            interval s, c;
+            interval_sincos(a.v, &s, &c, &f);
+            r->v = s;
+            r->d = dmul(a.d, c, &f);
             break;
+        }
+        case TAPE_COS: {
+            interval s, c;
+            interval_sincos(a.v, &s, &c, &f);
+            r->v = c;
+            r->d = dmul(a.d, interval_neg(s), &f);
+            break;
+        }
         case TAPE_TAN:
             r->v = interval_tan(a.v, &f);
             r->d = dmul(a.d, interval_add(ipt(1.0), interval_sqr(r->v, &f), &f), &f);

@@ -12,6 +12,8 @@ interval tape_eval_interval(const tape *t, const interval box[3], interval *s, u
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
     unsigned f = 0;
+    trig_memo tm;
+    trig_memo_init(&tm);
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         switch ((tape_op)in[i].op) {
         case TAPE_CONST: s[i].lo = k[in[i].a].lo; s[i].hi = k[in[i].a].hi; break;
@@ -24,8 +26,8 @@ interval tape_eval_interval(const tape *t, const interval box[3], interval *s, u
         case TAPE_EXP: s[i] = interval_exp(A, &f); break;
         case TAPE_LOG: s[i] = interval_log(A, &f); break;
         case TAPE_ABS: s[i] = interval_abs(A); break;
-        case TAPE_SIN: s[i] = interval_sin(A, &f); break;
-        case TAPE_COS: s[i] = interval_cos(A, &f); break;
+        case TAPE_SIN: { unsigned j = trig_memo_entry(&tm, in[i].a, A, &f); s[i] = tm.s[j]; break; }
+        case TAPE_COS: { unsigned j = trig_memo_entry(&tm, in[i].a, A, &f); s[i] = tm.c[j]; break; }
         case TAPE_TAN: s[i] = interval_tan(A, &f); break;
         case TAPE_ADD: s[i] = interval_add(A, C, &f); break;
         case TAPE_SUB: s[i] = interval_sub(A, C, &f); break;
@@ -72,6 +74,8 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
     unsigned f = 0;
+    trig_memo tm;
+    trig_memo_init(&tm);
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         tape_idual *r = &s[i];
         const tape_idual *a = s + slot_a(&in[i]), *c = s + slot_b(&in[i]);
@@ -111,10 +115,16 @@ interval tape_eval_interval_grad(const tape *t, const interval box[3], interval 
             iscale(r, a, v, m, &f);
             break;
         }
-        case TAPE_SIN: iscale(r, a, interval_sin(a->v, &f), interval_cos(a->v, &f), &f); break;
-        case TAPE_COS:
-            iscale(r, a, interval_cos(a->v, &f), interval_neg(interval_sin(a->v, &f)), &f);
+        case TAPE_SIN:
+        case TAPE_COS: {
+            unsigned j = trig_memo_entry(&tm, in[i].a, a->v, &f);
+            interval sv = tm.s[j], cv = tm.c[j];
+            if (in[i].op == TAPE_SIN)
+                iscale(r, a, sv, cv, &f);
+            else
+                iscale(r, a, cv, interval_neg(sv), &f);
             break;
+        }
         case TAPE_TAN: {
             interval v = interval_tan(a->v, &f);
             iscale(r, a, v, interval_add(ipt(1.0), interval_sqr(v, &f), &f), &f);

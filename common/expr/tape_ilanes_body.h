@@ -21,6 +21,8 @@
 #define ABS_FN CAT(FN, _abs)
 #define MINMAX_FN CAT(FN, _minmax)
 #define LIBM_FN CAT(FN, _libm)
+#define TRIG_FN CAT(FN, _trig)
+#define TRIG_MEMO_T CAT(FN, _trig_memo)
 
 /* a + c, or a - c (sub), as interval_add and interval_sub. */
 static void ADD_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a,
@@ -147,8 +149,6 @@ static void LIBM_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a,
         case TAPE_SQRT: v = interval_sqrt(x, &fl[l]); break;
         case TAPE_EXP: v = interval_exp(x, &fl[l]); break;
         case TAPE_LOG: v = interval_log(x, &fl[l]); break;
-        case TAPE_SIN: v = interval_sin(x, &fl[l]); break;
-        case TAPE_COS: v = interval_cos(x, &fl[l]); break;
         case TAPE_TAN: v = interval_tan(x, &fl[l]); break;
         case TAPE_DIV: v = interval_div(x, il_get(c, l), &fl[l]); break;
         case TAPE_POWC: v = interval_powc(x, e, &fl[l]); break;
@@ -163,11 +163,49 @@ static void LIBM_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a,
     }
 }
 
+/* sin or cos of slot a, lane by lane as LIBM_FN, through a memo of the last
+ * TRIG_MEMO arguments' sin and cos (tape_int.h's trig_memo, in lanes). */
+typedef struct TRIG_MEMO_T {
+    uint32_t arg[TRIG_MEMO];
+    tape_ilanes s[TRIG_MEMO], c[TRIG_MEMO];
+    unsigned next;
+} TRIG_MEMO_T;
+
+static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint32_t slot,
+                    int is_cos, TRIG_MEMO_T *m, unsigned n, unsigned *fl)
+{
+    unsigned j = 0;
+    while (j < TRIG_MEMO && m->arg[j] != slot)
+        j++;
+    if (j == TRIG_MEMO) {
+        j = m->next++ % TRIG_MEMO;
+        m->arg[j] = slot;
+        for (unsigned l = 0; l < n; l++) {
+            interval sv, cv;
+            interval_sincos(il_get(a, l), &sv, &cv, &fl[l]);
+            il_set(&m->s[j], l, sv);
+            il_set(&m->c[j], l, cv);
+        }
+        for (unsigned l = n; l < W; l++) {
+            m->s[j].lo[l] = m->s[j].lo[0];
+            m->s[j].hi[l] = m->s[j].hi[0];
+            m->c[j].lo[l] = m->c[j].lo[0];
+            m->c[j].hi[l] = m->c[j].hi[0];
+            fl[l] = fl[0];
+        }
+    }
+    *r = is_cos ? m->c[j] : m->s[j];
+}
+
 static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[W],
                tape_ilanes *s)
 {
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
+    TRIG_MEMO_T tm; /* entries are written before they are read */
+    for (unsigned j = 0; j < TRIG_MEMO; j++)
+        tm.arg[j] = UINT32_MAX;
+    tm.next = 0;
     for (uint32_t i = 0, len = t->n; i < len; i++) {
         tape_ilanes *restrict r = &s[i];
         uint32_t op = in[i].op;
@@ -201,6 +239,8 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
         case TAPE_MUL: MUL_FN(r, A, C, fl); break;
         case TAPE_MIN: MINMAX_FN(r, A, C, 1); break;
         case TAPE_MAX: MINMAX_FN(r, A, C, 0); break;
+        case TAPE_SIN: TRIG_FN(r, A, in[i].a, 0, &tm, n, fl); break;
+        case TAPE_COS: TRIG_FN(r, A, in[i].a, 1, &tm, n, fl); break;
         case TAPE_DIV: LIBM_FN(r, A, C, op, 0.0, n, fl); break;
         case TAPE_POWC: LIBM_FN(r, A, A, op, k[in[i].b].v, n, fl); break;
         case TAPE_NOPS: LIBM_FN(r, s, s, op, 0.0, n, fl); break;
@@ -218,3 +258,5 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
 #undef ABS_FN
 #undef MINMAX_FN
 #undef LIBM_FN
+#undef TRIG_FN
+#undef TRIG_MEMO_T

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "common/expr/interval_lanes.h"
+#include "common/expr/tape_int.h"
 #include "common/expr/tape.h"
 
 #define IL_CAT2(a, b) a##b

@@ -26,6 +26,37 @@ static inline void point_sincos(double x, double *s, double *c)
 #endif
 }
 
+/* The enclosures of sin and cos over the last TRIG_MEMO arguments of a
+ * trigonometric instruction in one evaluation (slots are written once), so
+ * that the sin and cos of one argument (gyroid's sin(3 pi x) and
+ * cos(3 pi x)) share one interval_sincos: the same bits as two calls, and
+ * the flags the first one raised are already in the evaluation's. */
+#define TRIG_MEMO 4
+typedef struct trig_memo {
+    uint32_t arg[TRIG_MEMO];
+    interval s[TRIG_MEMO], c[TRIG_MEMO];
+    unsigned next;
+} trig_memo;
+
+static inline void trig_memo_init(trig_memo *m)
+{
+    for (unsigned j = 0; j < TRIG_MEMO; j++)
+        m->arg[j] = UINT32_MAX;
+    m->next = 0;
+}
+
+/* The memo's entry for argument slot a (value x), made on a miss. */
+static inline unsigned trig_memo_entry(trig_memo *m, uint32_t a, interval x, unsigned *flags)
+{
+    for (unsigned j = 0; j < TRIG_MEMO; j++)
+        if (m->arg[j] == a)
+            return j;
+    unsigned j = m->next++ % TRIG_MEMO;
+    m->arg[j] = a;
+    interval_sincos(x, &m->s[j], &m->c[j], flags);
+    return j;
+}
+
 /* Operand slots of an instruction, 0 where the field is not a slot (a
  * constant-pool index, or unused), so that no pointer is formed outside
  * the caller's slot array. */
