@@ -45,6 +45,30 @@ static void line_point(const exact_line *l, double x, double p[3], double ep[3])
         ep[k] = tape_err_point(l->o[k], x, l->d[k], &p[k]);
 }
 
+/* g and g' at the computed point p of the line (within ep of the exact one,
+ * which lies in the region's box) with bounds on their errors: with the
+ * model's a-priori bound where p lies in its box too (then the segment
+ * between them does, and f's gradient and g''s over the box carry the
+ * input error: |f(p) - f(P)| <= sum grad_k ep_k, |g'(p) - g'(P)| <= sum
+ * ep_k hd_k), else tape_eval_dir_err. 1, or 0: no bound. */
+static int eval_bounded(const tape *t, exact_scratch *w, const exact_line *l,
+                        const exact_model *md, const double p[3], const double ep[3], tape_edir *e)
+{
+    const exact_bound *cb = md->cb;
+    if (cb && p[0] >= cb->box[0].lo && p[0] <= cb->box[0].hi && p[1] >= cb->box[1].lo &&
+        p[1] <= cb->box[1].hi && p[2] >= cb->box[2].lo && p[2] <= cb->box[2].hi) {
+        e->v = tape_eval_dir(t, p, l->d, &e->d, w->dir);
+        if (!(fabs(e->v) <= 0x1p100 && fabs(e->d) <= 0x1p100))
+            return 0;
+        e->ev = (cb->e.ev + cb->e.grad[0] * ep[0] + cb->e.grad[1] * ep[1] +
+                 cb->e.grad[2] * ep[2]) * CM;
+        e->ed = (md->fd + md->hd[0] * ep[0] + md->hd[1] * ep[1] + md->hd[2] * ep[2]) * CM;
+        w->nbound++;
+        return 1;
+    }
+    return tape_eval_dir_err(t, p, ep, l->d, e, w->edir);
+}
+
 /* The root t* of g in [a, b], where g is certified monotone with g' of sign
  * sg and |g'| >= dmin there: Newton steps from the model's estimate, plain
  * (tape_eval_dir) while the next step's quadratic error (K err^2 / 2 dmin,
@@ -75,7 +99,7 @@ static int place(const tape *t, exact_scratch *w, const exact_line *l, double a,
             continue;
         }
         tape_edir e;
-        if (!tape_eval_dir_err(t, p, ep, l->d, &e, w->edir))
+        if (!eval_bounded(t, w, l, md, p, ep, &e))
             return 0;
         const double rho = (fabs(e.v) + e.ev) / dmin * CM;
         const double dr = (e.ed + K * rho) * CM;
@@ -101,13 +125,24 @@ static int place(const tape *t, exact_scratch *w, const exact_line *l, double a,
 }
 
 int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
-                     exact_model *model)
+                     const exact_bound *cb, exact_model *model)
 {
     double p[3], ep[3];
     line_point(l, m, p, ep);
-    tape_edir e;
     model->m = m;
-    if (!tape_eval_dir_err(t, p, ep, l->d, &e, w->edir))
+    model->cb = cb;
+    if (cb) {
+        /* per line: the derivative's rounding bound and |d g'/dx_k| <=
+         * sum_j M_kj |d_j| (rounded up by CM: fewer than 20 roundings) */
+        const double *M = cb->hmag;
+        const double ax = fabs(l->d[0]), ay = fabs(l->d[1]), az = fabs(l->d[2]);
+        model->fd = (cb->e.ed[0] * ax + cb->e.ed[1] * ay + cb->e.ed[2] * az) * CM;
+        model->hd[0] = (M[TAPE_HXX] * ax + M[TAPE_HXY] * ay + M[TAPE_HXZ] * az) * CM;
+        model->hd[1] = (M[TAPE_HXY] * ax + M[TAPE_HYY] * ay + M[TAPE_HYZ] * az) * CM;
+        model->hd[2] = (M[TAPE_HXZ] * ax + M[TAPE_HYZ] * ay + M[TAPE_HZZ] * az) * CM;
+    }
+    tape_edir e;
+    if (!eval_bounded(t, w, l, model, p, ep, &e))
         return 0;
     model->v = e.v;
     model->d = e.d;
@@ -116,17 +151,21 @@ int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, doubl
     return 1;
 }
 
-int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                      double curv, const exact_model *model, double *root)
+#define ONE_ROOT 3 /* (classify: one root, to be placed) */
+
+/* The Taylor decisions of exact_fast_decide without the placing: NONE,
+ * UNDECIDED, or ONE_ROOT with g''s sign *sg and |g'| >= *dmin on [a, b]. */
+static inline int classify(const exact_model *model, double a, double b, double K, int *sg,
+                           double *dmin)
 {
     /* g'(m + s) within ed + K |s| of d (Taylor with |g''| <= K), |s| <= r
      * (1 + u) on the span (m may lie outside it) */
-    const double m = model->m, K = curv;
+    const double m = model->m;
     const double sa = a - m, sb = b - m;
     const double r = fmax(fabs(sa), fabs(sb));
     const double bd = (model->ed + K * r) * CM;
-    const int sg = model->d > bd ? 1 : model->d < -bd ? -1 : 0;
-    if (!sg) {
+    *sg = model->d > bd ? 1 : model->d < -bd ? -1 : 0;
+    if (!*sg) {
         /* g's linear part keeps one sign over the span, beyond the tail at r */
         const int ga = sign_at(model, sa, r, K);
         return ga && ga == sign_at(model, sb, r, K) ? EXACT_FAST_NONE : EXACT_FAST_UNDECIDED;
@@ -137,13 +176,65 @@ int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, doub
     if (ga == gb)
         return EXACT_FAST_NONE; /* monotone, the same sign at both ends */
     /* one root in (a, b); |g'| >= |d| - bd there (rounded down) */
-    const double dmin = (fabs(model->d) - bd) * (1.0 - 0x1p-50);
-    return place(t, w, l, a, b, sg, K, dmin, model, root) ? EXACT_FAST_ROOT
-                                                          : EXACT_FAST_UNDECIDED;
+    *dmin = (fabs(model->d) - bd) * (1.0 - 0x1p-50);
+    return ONE_ROOT;
+}
+
+int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                      double curv, const exact_model *model, double *root)
+{
+    int sg;
+    double dmin;
+    const int st = classify(model, a, b, curv, &sg, &dmin);
+    if (st != ONE_ROOT)
+        return st;
+    return place(t, w, l, a, b, sg, curv, dmin, model, root) ? EXACT_FAST_ROOT
+                                                             : EXACT_FAST_UNDECIDED;
+}
+
+/* Could a per-point model at the same m decide where this one did not?
+ * Not if the same model without any rounding error cannot (the decisions
+ * only get easier as ev and ed shrink); if the classification passed, the
+ * placing failed: retry. */
+static int worth_retry(const exact_model *model, double a, double b, double K)
+{
+    int sg;
+    double dmin;
+    if (classify(model, a, b, K, &sg, &dmin) == ONE_ROOT)
+        return 1;
+    exact_model exact = *model;
+    exact.ev = exact.ed = 0.0;
+    return classify(&exact, a, b, K, &sg, &dmin) != EXACT_FAST_UNDECIDED;
+}
+
+/* A new model at m: from cb's bound first, and where that gives none or
+ * does not decide (and a per-point bound might: worth_retry), from the
+ * per-point one; `retry`: this is such a second try already. */
+static int fresh(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                 double curv, const exact_bound *cb, double m, int retry, exact_model *model,
+                 int *have, double *root)
+{
+    if (cb) {
+        *have = exact_fast_model(t, w, l, m, cb, model);
+        if (*have) {
+            const int st = exact_fast_decide(t, w, l, a, b, curv, model, root);
+            if (st != EXACT_FAST_UNDECIDED || !worth_retry(model, a, b, curv))
+                return st;
+        }
+        w->nretry++;
+        retry = 1;
+    }
+    *have = exact_fast_model(t, w, l, m, NULL, model);
+    const int st = *have ? exact_fast_decide(t, w, l, a, b, curv, model, root)
+                         : EXACT_FAST_UNDECIDED;
+    if (retry && st != EXACT_FAST_UNDECIDED)
+        w->nrescue++;
+    return st;
 }
 
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                    double curv, exact_model *model, int *have, double *root)
+                    double curv, const exact_bound *cb, exact_model *model, int *have,
+                    double *root)
 {
     if (!(curv < INFINITY))
         return EXACT_FAST_UNDECIDED;
@@ -151,9 +242,13 @@ int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double
         const int st = exact_fast_decide(t, w, l, a, b, curv, model, root);
         if (st != EXACT_FAST_UNDECIDED)
             return st;
-        if (model->m >= a && model->m <= b)
-            return EXACT_FAST_UNDECIDED; /* a model of this span would be the same */
+        if (model->m >= a && model->m <= b) {
+            /* a model of this span would be the same, but for its bound */
+            if (!model->cb || !worth_retry(model, a, b, curv))
+                return EXACT_FAST_UNDECIDED;
+            w->nretry++;
+            return fresh(t, w, l, a, b, curv, NULL, model->m, 1, model, have, root);
+        }
     }
-    *have = exact_fast_model(t, w, l, 0.5 * (a + b), model);
-    return *have ? exact_fast_decide(t, w, l, a, b, curv, model, root) : EXACT_FAST_UNDECIDED;
+    return fresh(t, w, l, a, b, curv, cb, 0.5 * (a + b), 0, model, have, root);
 }

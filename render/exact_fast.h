@@ -9,6 +9,7 @@
 #define EXACT_FAST_H
 
 #include "common/expr/tape.h"
+#include "common/expr/tape_err_cell.h"
 #include "render/exact_hit.h"
 
 enum {
@@ -23,17 +24,32 @@ enum {
  * every point tested, rounded up; +inf when those are. */
 double exact_fast_curv(const double mag[6], const double d[3]);
 
+/* A region's a-priori rounding-error bound (tape_err_cell over its box,
+ * which holds every point tested there) and the magnitudes of its Hessian
+ * enclosure over the same box (tape_hess_mag): with them an evaluation at a
+ * point of the box is tape_eval_dir plus a constant (RENDER.md, "The
+ * a-priori bound"). */
+typedef struct exact_bound {
+    tape_cell_err e;
+    interval box[3];
+    const double *hmag;
+} exact_bound;
+
 /* A first-order model of g at m: g(m) and g'(m) in double with rigorous
- * bounds on their errors (tape_eval_dir_err at the computed point o + m d,
- * whose own rounding is bounded too). */
+ * bounds on their errors (at the computed point o + m d, whose own rounding
+ * is bounded too): from the region's a-priori bound (cb) or, where there is
+ * none or it does not decide, tape_eval_dir_err's running one (cb NULL). */
 typedef struct exact_model {
     double m;
     double v, d, ev, ed; /* |g(m) - v| <= ev, |g'(m) - d| <= ed */
+    const exact_bound *cb;
+    double fd, hd[3]; /* with cb: sum |d_k| ed_k, and sum_j M_kj |d_j| (|d g' / dx_k|) */
 } exact_model;
 
-/* Fills *model at m: 1, or 0 when the evaluation is flagged (no model). */
+/* Fills *model at m with cb's bound (cb may be NULL): 1, or 0 when the
+ * evaluation gives no bound (no model). */
 int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
-                     exact_model *model);
+                     const exact_bound *cb, exact_model *model);
 
 /* The first root of g(t) = f(o + t d) on [a, b] (a <= b, finite) decided
  * by Taylor's theorem from the model (at any m whose point lies in a box,
@@ -55,10 +71,13 @@ int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, doub
 /* exact_fast_decide with the caller's model (*have: it holds one, for this
  * line and a box as above) if that decides; else, unless the model's m is
  * in [a, b] already, with a new model at the midpoint (*model and *have
- * updated). EXACT_FAST_UNDECIDED when curv is +inf. (No interval of f over
- * the segment first: one model decides the voxels of the whole cell along
- * the line that it can, for the cost of about one such interval.) */
+ * updated), from cb's bound (may be NULL) and, if that does not decide,
+ * from the per-point one. EXACT_FAST_UNDECIDED when curv is +inf. (No
+ * interval of f over the segment first: one model decides the voxels of
+ * the whole cell along the line that it can, for the cost of about one such
+ * interval.) */
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                    double curv, exact_model *model, int *have, double *root);
+                    double curv, const exact_bound *cb, exact_model *model, int *have,
+                    double *root);
 
 #endif

@@ -19,7 +19,10 @@ int exact_scratch_init(exact_scratch *w, uint32_t n)
     w->idir = malloc(n * sizeof *w->idir);
     w->dir = malloc(n * sizeof *w->dir);
     w->edir = malloc(n * sizeof *w->edir);
-    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir || !w->edir) {
+    w->cerr = malloc(n * sizeof *w->cerr);
+    w->nbound = w->nretry = w->nrescue = 0;
+    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir || !w->edir ||
+        !w->cerr) {
         exact_scratch_free(w);
         return -1;
     }
@@ -35,6 +38,8 @@ void exact_scratch_free(exact_scratch *w)
     free(w->idir);
     free(w->dir);
     free(w->edir);
+    free(w->cerr);
+    w->cerr = NULL;
     w->edir = NULL;
     w->idir = NULL;
     w->dir = NULL;

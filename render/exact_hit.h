@@ -10,6 +10,7 @@
 #include "common/expr/tape.h"
 #include "common/expr/tape_dir.h"
 #include "common/expr/tape_err.h"
+#include "common/expr/tape_err_cell.h"
 
 /* A line p(t) = o + t * d in the tape's (world) coordinates. */
 typedef struct exact_line {
@@ -26,6 +27,11 @@ typedef struct exact_scratch {
     tape_idir1 *idir; /* the fast path's (render/exact_fast.c) */
     tape_dir1 *dir;
     tape_edir *edir;
+    tape_cerr *cerr;       /* tape_err_cell's */
+    /* statistics: evaluations with an a-priori bound; models whose a-priori
+     * bound did not decide (the per-point one tried), and of those the ones
+     * the per-point bound decided */
+    uint64_t nbound, nretry, nrescue;
 } exact_scratch;
 
 /* Allocates scratch for tapes of up to n instructions: 0, or -1 when out

@@ -246,22 +246,53 @@ int exact_worker_init(exact_worker *w, const exact_scene *es)
 {
     w->scene = es;
     w->fast = w->slow = 0;
+    w->bound_min_n = EXACT_BOUND_MIN_N;
     w->key_slot = UINT32_MAX;
     w->key_t = 0.0;
     w->have = 0;
-    if (exact_scratch_init(&w->scratch, es->max_n))
+    w->bound = malloc((es->ncand ? es->ncand : 1) * sizeof *w->bound);
+    w->bound_state = calloc(es->ncand ? es->ncand : 1, 1);
+    if (!w->bound || !w->bound_state || exact_scratch_init(&w->scratch, es->max_n)) {
+        free(w->bound);
+        free(w->bound_state);
         return -1;
+    }
     if (exact_sub_init(&w->sub, es->ncand, es->max_n)) {
         exact_scratch_free(&w->scratch);
+        free(w->bound);
+        free(w->bound_state);
         return -1;
     }
     return 0;
+}
+
+/* Candidate k's a-priori bound over its cell (the box its Hessian bound
+ * holds on), made on first use; NULL where there is none. It depends on
+ * the candidate alone, so images do not depend on which worker made it. */
+static const exact_bound *cell_bound(exact_worker *w, uint32_t k, const uint32_t v[3])
+{
+    if (w->bound_state[k] == 0) {
+        const exact_scene *es = w->scene;
+        const unsigned shift = es->tree->levels - es->depth;
+        const uint32_t c[3] = {v[0] >> shift, v[1] >> shift, v[2] >> shift};
+        exact_bound *b = &w->bound[k];
+        exact_scene_box(es, es->depth, c, b->box);
+        b->hmag = es->cand[k].hmag;
+        w->bound_state[k] =
+            tape_err_cell(&es->cand[k].t, b->box, &b->e, w->scratch.gslots, w->scratch.cerr) ? 1
+                                                                                              : 2;
+    }
+    return w->bound_state[k] == 1 ? &w->bound[k] : NULL;
 }
 
 void exact_worker_free(exact_worker *w)
 {
     exact_sub_free(&w->sub);
     exact_scratch_free(&w->scratch);
+    free(w->bound);
+    free(w->bound_state);
+    w->bound = NULL;
+    w->bound_state = NULL;
     w->scene = NULL;
 }
 
@@ -329,7 +360,10 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         const uint32_t j = k - es->first[slot];
         if (curv < INFINITY && j < EXACT_MODELS) {
             int have = (w->have >> j & 1u) && w->model_key[j] == key;
-            st = exact_fast_root(t_exact, &w->scratch, &l, a, b, curv, &w->model[j], &have, &t);
+            const exact_bound *cb =
+                key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
+            st = exact_fast_root(t_exact, &w->scratch, &l, a, b, curv, cb, &w->model[j], &have,
+                                 &t);
             w->have = (w->have & ~(UINT32_C(1) << j)) | (uint32_t)have << j;
             w->model_key[j] = key;
         }

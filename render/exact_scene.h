@@ -62,6 +62,11 @@ void exact_scene_box(const exact_scene *es, unsigned d, const uint32_t c[3], int
 
 #define EXACT_MODELS 8 /* candidates of a cell that keep a model */
 
+/* Tapes shorter than this keep the per-point bound: its making costs more
+ * than it saves there (csg's pruned tapes; docs/perf-log.md, "render
+ * --exact: the a-priori bound per cell"). */
+#define EXACT_BOUND_MIN_N 16
+
 /* A thread's state for the exact test: the scene and scratch for its tapes. */
 typedef struct exact_worker {
     const exact_scene *scene;
@@ -77,6 +82,12 @@ typedef struct exact_worker {
     uint32_t key_slot, have;
     exact_model model[EXACT_MODELS];
     uint64_t model_key[EXACT_MODELS];
+    /* per candidate of the scene, made on first use: its cell's a-priori
+     * bound (exact_fast.h), when bound_state is 1 (0: not made, 2: none) */
+    exact_bound *bound;
+    uint8_t *bound_state;
+    uint32_t bound_min_n; /* tapes shorter than this keep the per-point bound
+                             (EXACT_BOUND_MIN_N; a test may set it) */
 } exact_worker;
 
 int exact_worker_init(exact_worker *w, const exact_scene *es); /* 0, or -1: out of memory */

@@ -259,8 +259,13 @@ static void test_roots_on_faces(void **state)
  * axis-aligned rays (zero direction components), rays in voxel planes
  * (level 7 over [-1, 1]: planes at multiples of 1/64, so for `plane_box`
  * scenes) and rays near tangent to the sphere of radius 0.8 about the
- * centre (aimed at distances 0.8 (1 + 2^-k) from it). */
-static void fast_vs_fallback(const char *text, const double target[3], double min_fast)
+ * centre (aimed at distances 0.8 (1 + 2^-k) from it). The fast path takes
+ * the cells' a-priori bound on every tape; with `bounded`, its evaluations
+ * mostly use it
+ * (tape_err_cell), and few models that it cannot decide are decided by the
+ * per-point one. */
+static void fast_vs_fallback(const char *text, const double target[3], double min_fast,
+                             int bounded)
 {
     exact_built b;
     exact_built_make(text, 7, EXACT_CELL_DEPTH, &b);
@@ -275,6 +280,7 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
     exact_worker w1, w2;
     assert_int_equal(exact_worker_init(&w1, &b.es), 0);
     assert_int_equal(exact_worker_init(&w2, &off), 0);
+    w1.bound_min_n = 0; /* the a-priori bound on short tapes too */
     trace_opts o1 = {b.tree->levels, 0, &w1}, o2 = {b.tree->levels, 0, &w2};
     camera cam;
     look(&cam, eye_std, target, 64);
@@ -340,8 +346,12 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
             assert_true(fabs((double)h1.normal[a] - (double)h2.normal[a]) <= 1e-9);
     }
     if (getenv("EXACT_VERBOSE"))
-        printf("%u hits, %u the same; fast %llu, slow %llu\n", hits, same,
-               (unsigned long long)w1.fast, (unsigned long long)w1.slow);
+        printf("%u hits, %u the same; fast %llu, slow %llu; a-priori bound %llu, retried "
+               "%llu, rescued %llu\n", hits, same, (unsigned long long)w1.fast,
+               (unsigned long long)w1.slow, (unsigned long long)w1.scratch.nbound,
+               (unsigned long long)w1.scratch.nretry, (unsigned long long)w1.scratch.nrescue);
+    if (bounded)
+        assert_true(w1.scratch.nbound > (uint64_t)hits && w1.scratch.nrescue * 20 < hits);
     assert_true(hits > 500);
     assert_true(same * 3 >= hits);
     assert_true(w2.fast == 0);
@@ -356,19 +366,19 @@ static void test_fast_vs_fallback(void **state)
 {
     (void)state;
     static const double mid[3] = {0.5, 0.5, 0.5};
-    fast_vs_fallback("bounds -1 -1 -1 1 1 1\nsurface x^2 + y^2 + z^2 - 0.64\n", centre, 0.95);
+    fast_vs_fallback("bounds -1 -1 -1 1 1 1\nsurface x^2 + y^2 + z^2 - 0.64\n", centre, 0.95, 1);
     fast_vs_fallback("bounds -0.5 -0.5 -0.5 1.5 1.5 1.5\nsurface exp(-3.25*((x-0.78)^2+"
                      "(y-0.78)^2+(z-0.78)^2)) + exp(-3.25*((x-0.23)^2+(y-0.23)^2+(z-0.23)^2))"
                      " - 0.9\n",
-                     mid, 0.95);
+                     mid, 0.95, 1);
     fast_vs_fallback("bounds -1.3 -1.3 -1.3 1.3 1.3 1.3\n"
                      "surface (x^2 + y^2 + z^2 + 0.6^2 - 0.25^2)^2 - 4*0.6^2*(x^2 + y^2)\n",
-                     centre, 0.9);
+                     centre, 0.9, 1);
     /* creases: the sub-cells along them keep the fallback */
     fast_vs_fallback("bounds -1.1 -1.1 -1.1 1.1 1.1 1.1\n"
                      "surface max(max(abs(x), abs(y), abs(z)) - 0.8, x^2 + y^2 + z^2 - 1.0,"
                      " 0.16 - min(x^2 + y^2, y^2 + z^2, z^2 + x^2))\n",
-                     centre, 0.5);
+                     centre, 0.5, 0);
 }
 
 /* The coarse cells: a far surface is no candidate in a cell it cannot
