@@ -1,7 +1,8 @@
 /* exact_sub: Hessian bounds and pruned tapes per sub-cell of a coarse cell,
  * made on first use by each worker, for the candidates whose bound over the
- * whole coarse cell is +inf (min/max operands that overlap somewhere in it,
- * abs of an operand that changes sign there, a flag). A sub-cell where the
+ * whole coarse cell is +inf because min/max operands overlap somewhere in
+ * it or f may be undefined there (not where an abs of an operand that
+ * changes sign there is left: exact_sub_wanted). A sub-cell where the
  * kink's operands separate gets the tape with that min/max pruned to its
  * winner and a finite bound: the fast path runs there, and the fallback
  * and the normal evaluate the shorter tape. Sub-cells refine adaptively

@@ -3,7 +3,8 @@
  * finite-difference Hessians of f at random points of it; its pruned tape
  * gives f and the gradient bit for bit; an empty one holds no sign change;
  * rays aimed at crease lines and rays along voxel planes hit where the
- * exact reference caster (bench/refcast) does; the result of a ray does not
+ * exact reference caster (bench/refcast) does, on CSG and on gyroid_ball
+ * (whose kinked cells get no sub-cells); the result of a ray does not
  * depend on the order rays are cast, on a cache emptied on the way, or on
  * the thread count. */
 #include <setjmp.h>
@@ -269,6 +270,63 @@ static void test_csg_creases_vs_refcast(void **state)
     exact_built_free(&b);
 }
 
+/* gyroid_ball (scenes/gyroid_ball.scene): its rim's cells have both an
+ * abs that changes sign and a max whose operands overlap, and get no
+ * sub-cells (exact_sub_wanted); rays aimed at the rim, where the ball cuts
+ * the sheet, and rays along voxel planes hit where refcast does, at levels
+ * 7. */
+static void test_gyroid_ball_vs_refcast(void **state)
+{
+    (void)state;
+    static const char *const text =
+        "bounds -1 -1 -1 1 1 1\n"
+        "surface max(abs(sin(20*x)*cos(20*y) + sin(20*y)*cos(20*z) + sin(20*z)*cos(20*x)) - 0.2,"
+        " x^2 + y^2 + z^2 - 0.81)\n";
+    exact_built b;
+    exact_built_make(text, 7, EXACT_CELL_DEPTH, &b);
+    unsigned both = 0;
+    for (uint32_t k = 0; k < b.es.ncand; k++)
+        both += (b.es.cand[k].kinks & (TAPE_KINK_ABS | TAPE_KINK_MINMAX)) ==
+                (TAPE_KINK_ABS | TAPE_KINK_MINMAX);
+    assert_true(both > 20);
+    exact_worker w;
+    assert_int_equal(exact_worker_init(&w, &b.es), 0);
+    refcast_scratch *rw = refcast_scratch_new(b.sc);
+    assert_non_null(rw);
+    static const double eyes[][3] = {{2.2, 1.6, 1.9}, {0.3, -2.6, 0.4}, {-1.5, 1.2, -2.1}};
+    unsigned hits = 0;
+    for (unsigned e = 0; e < 3; e++)
+        for (unsigned k = 0; k < 400; k++) {
+            /* a point of the ball's sphere on the side facing the eye */
+            const double ph = acos(1.0 - 2.0 * (k + 0.5) / 400.0), th = 2.39996 * k;
+            double p[3] = {0.9 * sin(ph) * cos(th), 0.9 * sin(ph) * sin(th), 0.9 * cos(ph)};
+            if (p[0] * eyes[e][0] + p[1] * eyes[e][1] + p[2] * eyes[e][2] < 0.0)
+                continue;
+            const double dir[3] = {p[0] - eyes[e][0], p[1] - eyes[e][1], p[2] - eyes[e][2]};
+            hits += against_refcast(&b, &w, rw, eyes[e], dir);
+        }
+    const double h = ldexp(b.tree->edge, -(int)b.tree->levels);
+    for (unsigned k = 0; k < 300; k++) {
+        const int ax = (int)(k % 3);
+        double eye[3], dir[3];
+        for (int a = 0; a < 3; a++) {
+            eye[a] = a == ax ? -1.5 : b.tree->origin[a] + h * (double)(16 + (k * 7 + 13 * a) % 96);
+            dir[a] = a == ax ? 1.0 : 0.0;
+        }
+        if (k % 2)
+            dir[(ax + 1) % 3] = 0.3 * sin(0.1 * k);
+        hits += against_refcast(&b, &w, rw, eye, dir);
+    }
+    if (getenv("EXACT_VERBOSE"))
+        printf("gyroid_ball: %u cells with abs and max kinks, %u hits; fast %llu, slow %llu,"
+               " sub-cells %llu\n", both, hits, (unsigned long long)w.fast,
+               (unsigned long long)w.slow, (unsigned long long)w.sub.made);
+    assert_true(hits > 500);
+    refcast_scratch_free(rw);
+    exact_worker_free(&w);
+    exact_built_free(&b);
+}
+
 /* What a ray finds does not depend on the sub-cells its worker made before
  * (rays cast in reverse order, with a cache emptied every 64 sub-cells) nor
  * on the thread count (frame_render with 1 and 2 threads). */
@@ -352,6 +410,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sub_cells),
         cmocka_unit_test(test_csg_creases_vs_refcast),
+        cmocka_unit_test(test_gyroid_ball_vs_refcast),
         cmocka_unit_test(test_order_and_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
