@@ -79,6 +79,9 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
     ao_frame f;
     ao_basis(n, seed, &f);
     unsigned open = 0;
+    /* shadow_cast's choice, made once for the hit's rays */
+    const trace_occluded_fn occluded =
+        !opts->refine && !opts->exact ? trace_occluded_for(traverse) : NULL;
     for (unsigned k = k0; k < k0 + count; k++) {
         double d[3];
         ao_direction_in(&f, k, m, d);
@@ -87,7 +90,13 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
             open++;
             continue;
         }
-        open += !shadow_cast(tree, opts, traverse, &r, an, steps);
+        if (occluded) {
+            uint32_t ray_steps;
+            open += !occluded(tree, &r, an, &ray_steps);
+            *steps += ray_steps;
+        } else {
+            open += !shadow_cast(tree, opts, traverse, &r, an, steps);
+        }
     }
     return (float)open / (float)count;
 }

@@ -76,6 +76,36 @@ static inline unsigned dir_axes(const double d[3], double inv_out[3], int32_t sg
     return active;
 }
 
+/* setup_inside for a direction with no zero axis (every 1/d finite: an
+ * AO ray, nearly always): dir_axes' values and the loop's comparisons in
+ * the same order, written out without the zero-axis cases. */
+static inline int setup_inside_all(const trace_eye *e, const double d[3], double inv0,
+                                   double inv1, double inv2, trace_ray *r)
+{
+    const double inv[3] = {inv0, inv1, inv2};
+    double t_end = INFINITY;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const int neg = d[a] < 0.0;
+        r->inv[a] = inv[a];
+        r->sgn[a] = neg ? -1 : 1;
+        r->d[a] = d[a];
+        r->o[a] = e->o[a];
+        r->ot[a] = e->o[a];
+        r->v[a] = 0u;
+        const double te = (neg ? e->lo[a] : e->hi[a]) * inv[a];
+        if (te < t_end)
+            t_end = te;
+    }
+    if (!(t_end > 0.0))
+        return 0;
+    r->active = 7u;
+    r->t_base = 0.0;
+    r->t_start = 0.0;
+    r->t_end = t_end;
+    return 1;
+}
+
 /* trace_setup_eye from an eye inside the root cube (the start of secondary
  * rays): there every axis' slab entry time is <= 0, so the ray is never
  * re-based, and its slab exit time is the root exit time T(n or 0) the
@@ -90,6 +120,9 @@ static int setup_inside(const trace_eye *e, const double dir[3], trace_ray *r)
         d[a] = dir[a] * scale;
     if (!(fabs(d[0]) <= DBL_MAX && fabs(d[1]) <= DBL_MAX && fabs(d[2]) <= DBL_MAX))
         return 0;
+    const double inv0 = 1.0 / d[0], inv1 = 1.0 / d[1], inv2 = 1.0 / d[2];
+    if (fabs(inv0) <= DBL_MAX && fabs(inv1) <= DBL_MAX && fabs(inv2) <= DBL_MAX)
+        return setup_inside_all(e, d, inv0, inv1, inv2, r); /* dir_axes' test, every axis */
     const unsigned active = dir_axes(d, r->inv, r->sgn, r->d);
     double t_end = INFINITY;
 #pragma GCC unroll 3

@@ -37,6 +37,23 @@ typedef struct sse_axes {
 SSE_INLINE void sse_axes_init(const trace_ray *r, unsigned levels, sse_axes *ax, __m128d *TRxy,
                               __m128d *TRzw)
 {
+    if (!TRxy && r->active == 7u) {
+        /* no zero axis (nearly every secondary ray): the loop's values,
+           loaded as they are */
+        const unsigned f = (r->sgn[0] > 0 ? 1u : 0u) | (r->sgn[1] > 0 ? 2u : 0u) |
+                           (r->sgn[2] > 0 ? 4u : 0u);
+        ax->ZOxy = _mm_loadu_pd(r->ot);
+        ax->ZOzw = _mm_set_sd(r->ot[2]);
+        ax->ZIxy = _mm_loadu_pd(r->inv);
+        ax->ZIzw = _mm_set_sd(r->inv[2]);
+        ax->FARM = _mm_setr_epi32(-(int32_t)(f & 1u), -(int32_t)(f >> 1 & 1u),
+                                  -(int32_t)(f >> 2 & 1u), 0);
+        ax->WINF = _mm_setr_pd(-INFINITY, INFINITY);
+        ax->zoz = r->ot[2];
+        ax->ziz = r->inv[2];
+        ax->far = f;
+        return;
+    }
     double zo[4], zi[4], root[4];
     unsigned far = 0;
     const double nroot = (double)(UINT32_C(1) << levels);
@@ -378,16 +395,7 @@ int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anc
     if (anchor && anchor->depth) {
         /* the anchor's cell is the current one: tested like any other */
         d = anchor->depth;
-        unsigned k = 0;
-        for (; k < d; k += 2) { /* two frames a turn: frames 0..d, d < OCT_MAX_LEVELS */
-            _mm_storeu_si128((__m128i *)(void *)&fr[k],
-                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k]));
-            _mm_storeu_si128((__m128i *)(void *)&fr[k + 1],
-                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k + 1]));
-        }
-        if (k == d)
-            _mm_storeu_si128((__m128i *)(void *)&fr[k],
-                             _mm_loadu_si128((const __m128i *)(const void *)&anchor->node[k]));
+        memcpy(fr, anchor->node, (d + 1u) * sizeof fr[0]); /* frames 0..d, one layout */
         size = UINT32_C(1) << (levels - d);
         V = _mm_setr_epi32((int32_t)anchor->cell[0], (int32_t)anchor->cell[1],
                            (int32_t)anchor->cell[2], 0);
