@@ -113,17 +113,17 @@ interval tape_eval_interval_dir(const tape *t, const interval box[3], const doub
         }
         /* the value as tape_eval_interval makes it (interval_sincos), bit for bit */
         case TAPE_SIN: {
-            interval s, c;
-            interval_sincos(a.v, &s, &c, &f);
-            r->v = s;
-            r->d = dmul(a.d, c, &f);
+            interval sv, cv;
+            interval_sincos(a.v, &sv, &cv, &f);
+            r->v = sv;
+            r->d = dmul(a.d, cv, &f);
             break;
         }
         case TAPE_COS: {
-            interval s, c;
-            interval_sincos(a.v, &s, &c, &f);
-            r->v = c;
-            r->d = dmul(a.d, interval_neg(s), &f);
+            interval sv, cv;
+            interval_sincos(a.v, &sv, &cv, &f);
+            r->v = cv;
+            r->d = dmul(a.d, interval_neg(sv), &f);
             break;
         }
         case TAPE_TAN:
