@@ -21,17 +21,6 @@
 #include "tests/test_tape_util.h"
 #include "tests/tape_ref.h"
 
-static scene *parse(const char *expr)
-{
-    char text[512];
-    snprintf(text, sizeof text, "bounds -4 -4 -4 4 4 4\nsurface %s\n", expr);
-    scene *s = NULL;
-    scene_error e;
-    if (scene_parse(text, strlen(text), &s, &e) != 0)
-        fail_msg("%s: %s", expr, e.message);
-    return s;
-}
-
 typedef struct tally {
     unsigned tried, ok;
 } tally;
@@ -116,7 +105,7 @@ static void rand_err(const double p[3], double ep[3])
 static void run_loose(const char *expr, double lo, double hi, unsigned n, double min_ok,
                       double loose)
 {
-    scene *s = parse(expr);
+    scene *s = parse_surface(expr);
     const tape *t = &s->surfaces[0].tape;
     static double slots[MAXSLOTS];
     tally ty = {0, 0};
@@ -175,7 +164,7 @@ static void test_edges(void **state)
     run_loose("tan(x) + y", 1.5707963, 1.5707964, 2000, 0.0, 64.0);
     run("abs(x - 0.5) + y", 0.4999999, 0.5000001, 2000, 0.5);
     run("min(x, y) + max(x, z)", -1e-12, 1e-12, 2000, 0.0);
-    scene *s = parse("sqrt(x - 0.5) + log(y - 0.5) + 1/(z - 0.5)");
+    scene *s = parse_surface("sqrt(x - 0.5) + log(y - 0.5) + 1/(z - 0.5)");
     const tape *t = &s->surfaces[0].tape;
     static tape_edir es[MAXSLOTS];
     tape_edir e;
@@ -196,7 +185,7 @@ static void test_edges(void **state)
     const char *kinks[] = {"abs(x - 0.5)", "min(x, 0.5)", "max(0.5, x)", "tan(x - 0.5 + pi/2)",
                            "exp(x + 69.5)"};
     for (size_t i = 0; i < sizeof kinks / sizeof kinks[0]; i++) {
-        s = parse(kinks[i]);
+        s = parse_surface(kinks[i]);
         assert_int_equal(tape_eval_dir_err(&s->surfaces[0].tape, (double[3]){0.5, 0, 0}, ep, d,
                                            &e, es),
                          0);

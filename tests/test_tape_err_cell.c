@@ -20,17 +20,6 @@
 #include "tests/test_tape_util.h"
 #include "tests/tape_ref.h"
 
-static scene *parse(const char *expr)
-{
-    char text[1024];
-    snprintf(text, sizeof text, "bounds -4 -4 -4 4 4 4\nsurface %s\n", expr);
-    scene *s = NULL;
-    scene_error e;
-    if (scene_parse(text, strlen(text), &s, &e) != 0)
-        fail_msg("%s: %s", expr, e.message);
-    return s;
-}
-
 static tape_idual gs[MAXSLOTS];
 static tape_cerr cs[MAXSLOTS];
 static tape_dir1 ds[MAXSLOTS];
@@ -106,7 +95,7 @@ static void check_box(const char *what, const tape *t, const interval box[3], un
  * bounded. */
 static tally run(const char *expr, double lo, double hi, double size, unsigned nb, double min_ok)
 {
-    scene *s = parse(expr);
+    scene *s = parse_surface(expr);
     const tape *t = &s->surfaces[0].tape;
     tally ty = {0, 0, 0, 0.0};
     for (unsigned i = 0; i < nb / SCALE; i++) {
@@ -154,7 +143,7 @@ static void test_scenes(void **state)
 static void test_tight(void **state)
 {
     (void)state;
-    scene *s = parse(BLOBS_A);
+    scene *s = parse_surface(BLOBS_A);
     const tape *t = &s->surfaces[0].tape;
     tally ty = {0, 0, 0, 0.0};
     static double slots[MAXSLOTS];
@@ -184,7 +173,7 @@ static void test_gives_up(void **state)
                           "(y*y + 1)^0.375 + x", "exp(x + 69) + y", "sin(x + 1e8) + y"};
     const interval box[3] = {{-0.25, 0.25}, {-0.25, 0.25}, {-0.25, 0.25}};
     for (size_t i = 0; i < sizeof none / sizeof none[0]; i++) {
-        scene *s = parse(none[i]);
+        scene *s = parse_surface(none[i]);
         tape_cell_err ce;
         if (tape_err_cell(&s->surfaces[0].tape, box, &ce, gs, cs))
             fail_msg("%s: bounded over a box holding its edge", none[i]);
@@ -196,7 +185,7 @@ static void test_gives_up(void **state)
     const interval off[3] = {{1.0, 1.25}, {-0.25, 0.25}, {-0.25, 0.25}};
     tally ty = {0, 0, 0, 0.0};
     for (size_t i = 0; i < sizeof away / sizeof away[0]; i++) {
-        scene *s = parse(away[i]);
+        scene *s = parse_surface(away[i]);
         check_box(away[i], &s->surfaces[0].tape, off, 50, &ty);
         scene_free(s);
     }

@@ -16,17 +16,6 @@
 
 static const int hr[TAPE_HN] = {0, 0, 0, 1, 1, 2}, hc[TAPE_HN] = {0, 1, 2, 1, 2, 2};
 
-static scene *parse(const char *expr)
-{
-    char text[512];
-    snprintf(text, sizeof text, "bounds -4 -4 -4 4 4 4\nsurface %s\n", expr);
-    scene *s = NULL;
-    scene_error e;
-    if (scene_parse(text, strlen(text), &s, &e) != 0)
-        fail_msg("%s: %s", expr, e.message);
-    return s;
-}
-
 static double f_at(const tape *t, const double p[3], double *slots)
 {
     return tape_eval(t, p[0], p[1], p[2], slots);
@@ -115,7 +104,7 @@ static void test_hess_every_op(void **state)
 {
     (void)state;
     for (size_t k = 0; k < sizeof per_op / sizeof per_op[0]; k++) {
-        scene *s = parse(per_op[k]);
+        scene *s = parse_surface(per_op[k]);
         unsigned checked = 0;
         for (unsigned b = 0; b < 200 / SCALE + 5; b++) {
             interval box[3];
@@ -162,7 +151,7 @@ static void test_hess_off(void **state)
         {"tan(x)", 1.0, 2.0, 0},      {"x^0.5 + y", 0.0, 1.0, 0},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        scene *s = parse(cases[k].expr);
+        scene *s = parse_surface(cases[k].expr);
         const interval box[3] = {{cases[k].lo, cases[k].hi}, {0.5, 1.0}, {0.5, 1.0}};
         double mag[TAPE_HN];
         const int ok = tape_hess_mag(&s->surfaces[0].tape, box, hs, mag);
@@ -229,7 +218,7 @@ static void test_dir_every_op(void **state)
 {
     (void)state;
     for (size_t k = 0; k < sizeof per_op / sizeof per_op[0]; k++) {
-        scene *s = parse(per_op[k]);
+        scene *s = parse_surface(per_op[k]);
         unsigned enclosed = 0;
         for (unsigned n = 0; n < 100; n++) {
             interval box[3];

@@ -1,4 +1,4 @@
-/* Helpers shared by the tape tests (test_tape.c, test_tape_prune.c): a
+/* Helpers shared by the tape tests (test_tape*.c): a
  * deterministic random source, enclosure checks and random expression trees
  * compiled through the scene parser. static inline: each test uses a part.
  * Include after cmocka.h (rand_tree fails the test on a parser error). */
@@ -99,6 +99,19 @@ static inline void gen(char **p, char *end, int depth)
         gen(p, end, depth - 1);
         *p += sprintf(*p, ")");
     }
+}
+
+/* The scene "surface EXPR" in the box [-4, 4]^3; a parser error fails the
+ * test. */
+static inline scene *parse_surface(const char *expr)
+{
+    char text[1024];
+    snprintf(text, sizeof text, "bounds -4 -4 -4 4 4 4\nsurface %s\n", expr);
+    scene *s = NULL;
+    scene_error e;
+    if (scene_parse(text, strlen(text), &s, &e) != 0)
+        fail_msg("%s: %s", expr, e.message);
+    return s;
 }
 
 /* A random scene whose surface is a random tree of depth <= 6. */
