@@ -106,6 +106,32 @@ static inline int setup_inside_all(const trace_eye *e, const double d[3], double
     return 1;
 }
 
+/* The axis part of an inside set-up once r's inv, sgn and d are made: the
+ * origin, its voxel on inactive axes, and the root exit time. 0: no ray. */
+static inline int inside_axes(const trace_eye *e, unsigned active, trace_ray *r)
+{
+    double t_end = INFINITY;
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+        const int act = active >> a & 1u;
+        r->o[a] = e->o[a];
+        r->ot[a] = act ? e->o[a] : -INFINITY;
+        r->v[a] = act ? 0u : floor_clamp(e->o[a], 0, e->nvox - 1);
+        if (act) {
+            const double te = (r->d[a] < 0.0 ? e->lo[a] : e->hi[a]) * r->inv[a];
+            if (te < t_end)
+                t_end = te;
+        }
+    }
+    if (!active || !(t_end > 0.0))
+        return 0;
+    r->active = active;
+    r->t_base = 0.0;
+    r->t_start = 0.0;
+    r->t_end = t_end;
+    return 1;
+}
+
 /* trace_setup_eye from an eye inside the root cube (the start of secondary
  * rays): there every axis' slab entry time is <= 0, so the ray is never
  * re-based, and its slab exit time is the root exit time T(n or 0) the
@@ -123,27 +149,7 @@ static int setup_inside(const trace_eye *e, const double dir[3], trace_ray *r)
     const double inv0 = 1.0 / d[0], inv1 = 1.0 / d[1], inv2 = 1.0 / d[2];
     if (fabs(inv0) <= DBL_MAX && fabs(inv1) <= DBL_MAX && fabs(inv2) <= DBL_MAX)
         return setup_inside_all(e, d, inv0, inv1, inv2, r); /* dir_axes' test, every axis */
-    const unsigned active = dir_axes(d, r->inv, r->sgn, r->d);
-    double t_end = INFINITY;
-#pragma GCC unroll 3
-    for (int a = 0; a < 3; a++) {
-        const int act = active >> a & 1u;
-        r->o[a] = e->o[a];
-        r->ot[a] = act ? e->o[a] : -INFINITY;
-        r->v[a] = act ? 0u : floor_clamp(e->o[a], 0, e->nvox - 1);
-        if (act) {
-            const double te = (d[a] < 0.0 ? e->lo[a] : e->hi[a]) * r->inv[a];
-            if (te < t_end)
-                t_end = te;
-        }
-    }
-    if (!active || !(t_end > 0.0))
-        return 0;
-    r->active = active;
-    r->t_base = 0.0;
-    r->t_start = 0.0;
-    r->t_end = t_end;
-    return 1;
+    return inside_axes(e, dir_axes(d, r->inv, r->sgn, r->d), r);
 }
 
 int trace_setup_eye(const trace_eye *e, const double dir[3], trace_ray *r)
@@ -181,30 +187,12 @@ int trace_setup_dir(const trace_eye *e, const trace_dir *td, trace_ray *r)
     if (!td->ok)
         return 0;
     /* setup_inside with the direction's part made: the same values */
-    const unsigned active = td->active;
-    double t_end = INFINITY;
-#pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-        const int act = active >> a & 1u;
         r->inv[a] = td->inv[a];
         r->sgn[a] = td->sgn[a];
         r->d[a] = td->d[a];
-        r->o[a] = e->o[a];
-        r->ot[a] = act ? e->o[a] : -INFINITY;
-        r->v[a] = act ? 0u : floor_clamp(e->o[a], 0, e->nvox - 1);
-        if (act) {
-            const double te = (td->d[a] < 0.0 ? e->lo[a] : e->hi[a]) * td->inv[a];
-            if (te < t_end)
-                t_end = te;
-        }
     }
-    if (!(t_end > 0.0))
-        return 0;
-    r->active = active;
-    r->t_base = 0.0;
-    r->t_start = 0.0;
-    r->t_end = t_end;
-    return 1;
+    return inside_axes(e, td->active, r);
 }
 
 int trace_setup_eye_general(const trace_eye *e, const double dir[3], trace_ray *r)
