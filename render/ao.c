@@ -80,8 +80,7 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
     ao_basis(n, seed, &f);
     unsigned open = 0;
     /* shadow_cast's choice, made once for the hit's rays */
-    const trace_occluded_fn occluded =
-        !opts->refine && !opts->exact ? trace_occluded_for(traverse) : NULL;
+    const trace_occluded_fn occluded = shadow_any_hit(opts, traverse);
     for (unsigned k = k0; k < k0 + count; k++) {
         double d[3];
         ao_direction_in(&f, k, m, d);

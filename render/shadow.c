@@ -102,12 +102,18 @@ int shadow_origin_at(const oct_tree *tree, const double p[3], const float n[3], 
     return ok;
 }
 
+trace_occluded_fn shadow_any_hit(const trace_opts *opts, trace_traverse_fn traverse)
+{
+    return !opts->refine && !opts->exact ? trace_occluded_for(traverse) : NULL;
+}
+
 int shadow_cast(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                 const trace_ray *r, const trace_anchor *an, uint64_t *steps)
 {
-    if (!opts->refine && !opts->exact) {
+    const trace_occluded_fn occluded = shadow_any_hit(opts, traverse);
+    if (occluded) {
         uint32_t n;
-        const int hit = trace_occluded_for(traverse)(tree, r, an, &n);
+        const int hit = occluded(tree, r, an, &n);
         *steps += n;
         return hit;
     }

@@ -74,6 +74,10 @@ int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float 
                         const float n[3], shadow_start *s);
 int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s);
 
+/* The any-hit walk shadow_cast uses for opts and traverse (under the paper's
+ * rule: traverse's implementation's), or NULL: the full traversal. */
+trace_occluded_fn shadow_any_hit(const trace_opts *opts, trace_traverse_fn traverse);
+
 /* 1 when the prepared ray r, started at anchor an (or NULL), meets an
  * occupied voxel by opts' rule: under the paper's rule the any-hit walk of
  * traverse's implementation (trace_impl.h), else traverse itself (NULL:
