@@ -67,7 +67,9 @@ int image_png_alpha_to(atomic_file *af, const uint8_t *rgb, const uint8_t *alpha
         errno = EOVERFLOW;
         return -1;
     }
-    uint8_t *row = alpha ? malloc(4 * (size_t)w) : NULL; /* RGBA rows, interleaved */
+    /* RGBA rows, interleaved; volatile: live across setjmp, which gcc without
+     * LTO flags (-Wclobbered) although it is never changed after it */
+    uint8_t *volatile row = alpha ? malloc(4 * (size_t)w) : NULL;
     if (alpha && !row) {
         errno = ENOMEM;
         return -1;
