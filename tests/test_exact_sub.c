@@ -112,7 +112,7 @@ static void check_scene(const char *text, unsigned levels, unsigned depth, sub_c
     tape_dual *ds = malloc(b.es.max_n * sizeof *ds);
     assert_true(slots && ds);
     for (unsigned it = 0; it < 1500; it++) {
-        uint32_t v[3], slot;
+        uint32_t v[3], slot = 0; /* set by random_voxel, which the assert requires */
         assert_true(random_voxel(&b, v, &slot));
         exact_sub_reserve(&c);
         const uint32_t k = b.es.first[slot];

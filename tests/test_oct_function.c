@@ -166,7 +166,7 @@ static void test_instructions(void **state)
     loc L;
     locate(buf, &L);
     unsigned char *c = malloc(len);
-    uint32_t i_const, i_x, i_un, i_bin, i_pow;
+    uint32_t i_const = 0, i_x = 0, i_un = 0, i_bin = 0, i_pow = 0; /* set by insn_at (it asserts) */
     const uint64_t ic = insn_at(buf, &L, OCT_OP_CONST, &i_const), ix = insn_at(buf, &L, OCT_OP_Y, &i_x);
     const uint64_t iu = insn_at(buf, &L, OCT_OP_SQRT, &i_un), ib = insn_at(buf, &L, OCT_OP_DIV, &i_bin);
     const uint64_t ip = insn_at(buf, &L, OCT_OP_POWC, &i_pow);
