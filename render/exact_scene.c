@@ -305,7 +305,7 @@ void exact_worker_free(exact_worker *w)
 /* The ray's line in world units, local t: p(t) = origin + (o + t d) h, and
  * the span's widening, 2^-16 voxel along the ray (made when the ray's o or
  * d is not the last one's: once for a ray's voxels). */
-static void make_line(exact_worker *w, const trace_ray *r)
+static __attribute__((noinline)) void make_line(exact_worker *w, const trace_ray *r)
 {
     const exact_scene *es = w->scene;
     const oct_tree *tree = es->tree;
@@ -320,6 +320,20 @@ static void make_line(exact_worker *w, const trace_ray *r)
                   memcmp(w->key + 3, w->line.d, sizeof w->line.d);
     memcpy(w->ray_od, r->o, sizeof r->o);
     memcpy(w->ray_od + 3, r->d, sizeof r->d);
+}
+
+/* The hit at local t of the surface whose exact tape is t: its normal and
+ * surface (out of line: most voxels tested hold no root). */
+static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t, double best,
+                                                 uint32_t surface, trace_hit *hit)
+{
+    const exact_line *l = &w->line;
+    double p[3];
+    for (int k = 0; k < 3; k++)
+        p[k] = l->o[k] + best * l->d[k];
+    exact_normal(t, &w->scratch, p, l->d, hit->normal);
+    hit->exact = 1;
+    hit->surface = surface;
 }
 
 int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
@@ -414,12 +428,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
     }
     if (!(best < INFINITY))
         return 0;
-    double p[3];
-    for (int k = 0; k < 3; k++)
-        p[k] = l->o[k] + best * l->d[k];
-    exact_normal(&win, &w->scratch, p, l->d, hit->normal);
-    hit->exact = 1;
-    hit->surface = es->cand[best_k].surface;
+    finish_hit(w, &win, best, es->cand[best_k].surface, hit);
     *t_hit = best;
     return 1;
 }
