@@ -206,8 +206,8 @@ static void coarse_region(exact_region *out, const exact_scene *es, const exact_
 
 /* (exact_sub_find without the last regions; -1: out of memory; out of
  * line, as the last region is mostly the one) */
-static __attribute__((noinline)) int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const uint32_t v[3],
-                  exact_region *out)
+static __attribute__((noinline)) int lookup(exact_sub_cache *c, const exact_scene *es,
+                                            uint32_t k, const uint32_t v[3], exact_region *out)
 {
     const exact_cand *cd = &es->cand[k];
     const unsigned L = es->tree->levels, D = es->depth;
