@@ -250,6 +250,12 @@ int exact_worker_init(exact_worker *w, const exact_scene *es)
     w->key_slot = UINT32_MAX;
     w->key_t = 0.0;
     w->have = 0;
+    w->have_curv = 0;
+    w->line_new = 1;
+    memset(w->key, 0, sizeof w->key);
+    /* (no ray's: its d is finite and not all 0) */
+    for (int a = 0; a < 6; a++)
+        w->ray_od[a] = NAN;
     w->bound = malloc((es->ncand ? es->ncand : 1) * sizeof *w->bound);
     w->bound_state = calloc(es->ncand ? es->ncand : 1, 1);
     if (!w->bound || !w->bound_state || exact_scratch_init(&w->scratch, es->max_n)) {
@@ -296,46 +302,74 @@ void exact_worker_free(exact_worker *w)
     w->scene = NULL;
 }
 
+/* The ray's line in world units, local t: p(t) = origin + (o + t d) h, and
+ * the span's widening, 2^-16 voxel along the ray (made when the ray's o or
+ * d is not the last one's: once for a ray's voxels). */
+static __attribute__((noinline)) void make_line(exact_worker *w, const trace_ray *r)
+{
+    const exact_scene *es = w->scene;
+    const oct_tree *tree = es->tree;
+    double dd = 0.0;
+    for (int a = 0; a < 3; a++) {
+        w->line.o[a] = tree->origin[a] + r->o[a] * es->h;
+        w->line.d[a] = r->d[a] * es->h;
+        dd += r->d[a] * r->d[a];
+    }
+    w->widen = 0x1p-16 / sqrt(dd);
+    w->line_new = memcmp(w->key, w->line.o, sizeof w->line.o) ||
+                  memcmp(w->key + 3, w->line.d, sizeof w->line.d);
+    memcpy(w->ray_od, r->o, sizeof r->o);
+    memcpy(w->ray_od + 3, r->d, sizeof r->d);
+}
+
+/* The hit at local t of the surface whose exact tape is t: its normal and
+ * surface (out of line: most voxels tested hold no root). */
+static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t, double best,
+                                                 uint32_t surface, trace_hit *hit)
+{
+    const exact_line *l = &w->line;
+    double p[3];
+    for (int k = 0; k < 3; k++)
+        p[k] = l->o[k] + best * l->d[k];
+    exact_normal(t, &w->scratch, p, l->d, hit->normal);
+    hit->exact = 1;
+    hit->surface = surface;
+}
+
 int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
                 double t_out, double *t_hit, trace_hit *hit)
 {
     const exact_scene *es = w->scene;
-    const oct_tree *tree = es->tree;
-    const unsigned shift = tree->levels - es->depth;
+    const unsigned shift = es->tree->levels - es->depth;
     const uint32_t dim = UINT32_C(1) << es->depth;
     const uint32_t slot =
         es->cell_slot[((size_t)(v[2] >> shift) * dim + (v[1] >> shift)) * dim + (v[0] >> shift)];
     if (slot == UINT32_MAX)
         return 0; /* (a voxel's cell is always registered) */
-    /* the ray in world units, local t: p(t) = origin + (o + t d) h */
-    exact_line l;
-    double dd = 0.0;
-    for (int a = 0; a < 3; a++) {
-        l.o[a] = tree->origin[a] + r->o[a] * es->h;
-        l.d[a] = r->d[a] * es->h;
-        dd += r->d[a] * r->d[a];
-    }
+    if (memcmp(w->ray_od, r->o, sizeof r->o) || memcmp(w->ray_od + 3, r->d, sizeof r->d))
+        make_line(w, r);
+    const exact_line *l = &w->line;
     /* a new line, cell, or traversal (a line traced again starts before
      * where it was last tested): the models start afresh, so that what a ray
      * finds depends on that ray alone */
-    if (slot != w->key_slot || t_in < w->key_t || memcmp(w->key, l.o, sizeof l.o) ||
-        memcmp(w->key + 3, l.d, sizeof l.d)) {
-        memcpy(w->key, l.o, sizeof l.o);
-        memcpy(w->key + 3, l.d, sizeof l.d);
+    if (w->line_new || slot != w->key_slot || t_in < w->key_t) {
+        memcpy(w->key, l->o, sizeof l->o);
+        memcpy(w->key + 3, l->d, sizeof l->d);
+        w->line_new = 0;
         w->key_slot = slot;
         w->have = 0;
+        w->have_curv = 0;
     }
     w->key_t = t_in;
-    const double widen = 0x1p-16 / sqrt(dd); /* 2^-16 voxel along the ray */
-    double a = t_in - widen, b = t_out + widen;
+    double a = t_in - w->widen, b = t_out + w->widen;
     if (a < -r->t_base)
         a = -r->t_base; /* the caller's t >= 0 */
     double best = INFINITY;
     tape win; /* the winner's exact tape */
     uint32_t best_k = 0;
-    if (es->sub_max)
-        exact_sub_reserve(&w->sub);
-    for (uint32_t k = es->first[slot]; k < es->first[slot + 1]; k++) {
+    int reserved = 0; /* exact_sub_reserve called for this voxel */
+    const uint32_t k0 = es->first[slot], k1 = es->first[slot + 1];
+    for (uint32_t k = k0; k < k1; k++) {
         if (!(a <= b))
             break;
         /* the cell's tapes and bound, or where that is +inf its sub-cell's */
@@ -344,6 +378,10 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         const double *hmag = c->hmag;
         uint64_t key = 0;
         if (!(hmag[0] < INFINITY) && es->sub_max && exact_sub_wanted(c->kinks)) {
+            if (!reserved) {
+                exact_sub_reserve(&w->sub);
+                reserved = 1;
+            }
             const exact_region *rg = exact_sub_find(&w->sub, es, k, v);
             if (rg->empty) {
                 w->fast++;
@@ -354,22 +392,30 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             hmag = rg->hmag;
             key = rg->key;
         }
-        const double curv = exact_fast_curv(hmag, l.d);
         double t = INFINITY;
         int st = EXACT_FAST_UNDECIDED;
-        const uint32_t j = k - es->first[slot];
-        if (curv < INFINITY && j < EXACT_MODELS) {
-            int have = (w->have >> j & 1u) && w->model_key[j] == key;
-            const exact_bound *cb =
-                key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
-            st = exact_fast_root(t_exact, &w->scratch, &l, a, b, curv, cb, &w->model[j], &have,
-                                 &t);
-            w->have = (w->have & ~(UINT32_C(1) << j)) | (uint32_t)have << j;
-            w->model_key[j] = key;
+        const uint32_t j = k - k0;
+        if (j < EXACT_MODELS) {
+            const uint32_t bit = UINT32_C(1) << j;
+            if (!(w->have_curv & bit) || w->curv_key[j] != key) {
+                w->curv[j] = exact_fast_curv(hmag, l->d);
+                w->curv_key[j] = key;
+                w->have_curv |= bit;
+            }
+            const double curv = w->curv[j];
+            if (curv < INFINITY) {
+                int have = (w->have & bit) && w->model_key[j] == key;
+                const exact_bound *cb =
+                    key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
+                st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, &w->model[j],
+                                     &have, &t);
+                w->have = (w->have & ~bit) | (uint32_t)have << j;
+                w->model_key[j] = key;
+            }
         }
         if (st == EXACT_FAST_UNDECIDED) {
             w->slow++;
-            t = exact_first_root(t_exact, t_cull, &w->scratch, &l, a, b, NULL);
+            t = exact_first_root(t_exact, t_cull, &w->scratch, l, a, b, NULL);
         } else {
             w->fast++;
         }
@@ -382,12 +428,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
     }
     if (!(best < INFINITY))
         return 0;
-    double p[3];
-    for (int k = 0; k < 3; k++)
-        p[k] = l.o[k] + best * l.d[k];
-    exact_normal(&win, &w->scratch, p, l.d, hit->normal);
-    hit->exact = 1;
-    hit->surface = es->cand[best_k].surface;
+    finish_hit(w, &win, best, es->cand[best_k].surface, hit);
     *t_hit = best;
     return 1;
 }

@@ -82,6 +82,18 @@ typedef struct exact_worker {
     uint32_t key_slot, have;
     exact_model model[EXACT_MODELS];
     uint64_t model_key[EXACT_MODELS];
+    /* candidate k's curvature bound (exact_fast_curv) on that line when bit
+     * k of `have_curv` is set, for the region curv_key[k] */
+    uint32_t have_curv;
+    double curv[EXACT_MODELS];
+    uint64_t curv_key[EXACT_MODELS];
+    /* The line of the last test in world units and its widening, made from
+     * the ray's o and d (ray_od) once for all of its voxels; line_new: it
+     * differs from `key` (the models start afresh at the next voxel). */
+    double ray_od[6];
+    exact_line line;
+    double widen;
+    int line_new;
     /* per candidate of the scene, made on first use: its cell's a-priori
      * bound (exact_fast.h), when bound_state is 1 (0: not made, 2: none) */
     exact_bound *bound;

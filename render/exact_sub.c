@@ -39,6 +39,7 @@ int exact_sub_init(exact_sub_cache *c, uint32_t ncand, uint32_t max_n)
         return -1;
     }
     memset(c->top, 0xff, ((size_t)ncand + 1) * sizeof *c->top);
+    memset(c->last_k, 0xff, sizeof c->last_k);
     return 0;
 }
 
@@ -64,6 +65,7 @@ static void reset(exact_sub_cache *c)
     c->cur = 0;
     c->chunk_used = 0;
     memset(c->top, 0xff, ((size_t)c->ncand + 1) * sizeof *c->top);
+    memset(c->last_k, 0xff, sizeof c->last_k);
     c->resets++;
 }
 
@@ -187,22 +189,32 @@ static void region_of(exact_region *out, const exact_cand *cd, const exact_sub_n
     out->empty = nd->empty;
 }
 
-/* (exact_sub_find without the last regions; -1: out of memory) */
-static int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const uint32_t v[3],
-                  exact_region *out)
+/* *out: candidate cd's coarse cell, the one holding voxel v */
+static void coarse_region(exact_region *out, const exact_scene *es, const exact_cand *cd,
+                          const uint32_t v[3])
 {
-    const exact_cand *cd = &es->cand[k];
     out->t = cd->t;
     out->cull = cd->cull;
     memcpy(out->hmag, cd->hmag, sizeof out->hmag);
     out->key = 0;
     out->empty = 0;
-    const unsigned L = es->tree->levels, D = es->depth;
-    out->depth = D;
+    out->depth = es->depth;
+    out->shift = es->tree->levels - es->depth;
     for (int a = 0; a < 3; a++)
-        out->corner[a] = v[a] >> (L - D);
-    if (!es->sub_max || cd->hmag[0] < INFINITY || !exact_sub_wanted(cd->kinks))
+        out->corner[a] = v[a] >> out->shift;
+}
+
+/* (exact_sub_find without the last regions; -1: out of memory; out of
+ * line, as the last region is mostly the one) */
+static __attribute__((noinline)) int lookup(exact_sub_cache *c, const exact_scene *es,
+                                            uint32_t k, const uint32_t v[3], exact_region *out)
+{
+    const exact_cand *cd = &es->cand[k];
+    const unsigned L = es->tree->levels, D = es->depth;
+    if (!es->sub_max || cd->hmag[0] < INFINITY || !exact_sub_wanted(cd->kinks)) {
+        coarse_region(out, es, cd, v);
         return 0;
+    }
     uint32_t owner = NONE; /* the node whose block is searched; NONE: the candidate's */
     tape p = cd->t;
     for (unsigned r = 0;;) {
@@ -210,8 +222,10 @@ static int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const u
         r += s;
         uint32_t b = owner == NONE ? c->top[k] : c->node[owner].child;
         if (b == NONE) {
-            if ((b = new_block(c)) == NONE)
+            if ((b = new_block(c)) == NONE) {
+                coarse_region(out, es, cd, v);
                 return -1;
+            }
             if (owner == NONE)
                 c->top[k] = b;
             else
@@ -225,8 +239,10 @@ static int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const u
         }
         uint32_t i = c->block[(size_t)b * FAN + idx];
         if (i == NONE) {
-            if ((i = make_node(c, es, cd, &p, D + r, cc)) == NONE)
+            if ((i = make_node(c, es, cd, &p, D + r, cc)) == NONE) {
+                coarse_region(out, es, cd, v);
                 return -1;
+            }
             c->block[(size_t)b * FAN + idx] = i;
         }
         const exact_sub_node *nd = &c->node[i];
@@ -238,6 +254,7 @@ static int lookup(exact_sub_cache *c, const exact_scene *es, uint32_t k, const u
                                  (uint64_t)cc[1] << 20 | cc[0];
             region_of(out, cd, nd, key);
             out->depth = D + r;
+            out->shift = L - D - r;
             memcpy(out->corner, cc, sizeof cc);
             return 0;
         }
@@ -253,16 +270,11 @@ const exact_region *exact_sub_find(exact_sub_cache *c, const exact_scene *es, ui
 {
     const uint32_t i = k % EXACT_SUB_LAST;
     exact_region *r = &c->last[i];
-    const unsigned L = es->tree->levels;
-    if (c->last_k[i] == k && c->last_gen[i] == c->resets + 1 &&
-        v[0] >> (L - r->depth) == r->corner[0] && v[1] >> (L - r->depth) == r->corner[1] &&
-        v[2] >> (L - r->depth) == r->corner[2])
+    const unsigned s = r->shift;
+    if (c->last_k[i] == k &&
+        !((v[0] >> s ^ r->corner[0]) | (v[1] >> s ^ r->corner[1]) | (v[2] >> s ^ r->corner[2])))
         return r;
-    if (lookup(c, es, k, v, r) == 0) {
-        c->last_k[i] = k;
-        c->last_gen[i] = c->resets + 1;
-    } else {
-        c->last_gen[i] = 0; /* (the coarse cell's, in *r: not remembered) */
-    }
+    /* (out of memory: the coarse cell's, in *r, not remembered) */
+    c->last_k[i] = lookup(c, es, k, v, r) == 0 ? k : UINT32_MAX;
     return r;
 }

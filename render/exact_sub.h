@@ -50,6 +50,7 @@ typedef struct exact_region {
     uint64_t key;       /* 0: the coarse cell; else the sub-cell (depth, corner) */
     unsigned depth;     /* the region's depth in the tree and its corner in cells */
     uint32_t corner[3]; /* of that depth (exact_scene_box gives its box) */
+    unsigned shift;     /* levels - depth: a voxel v lies in it iff v >> shift is corner */
     int empty;          /* certified: the surface has no point in the region */
 } exact_region;
 
@@ -73,11 +74,10 @@ typedef struct exact_sub_cache {
     tape_insn *tmp_insn;
     uint32_t *tmp_mark;
     uint32_t max_nodes;    /* the soft limit (EXACT_SUB_NODES; tests set less) */
-    /* the last region found for candidate last_k[i] (i = k mod EXACT_SUB_LAST),
-     * valid while last_gen[i] is resets + 1 */
+    /* the last region found for candidate last_k[i] (i = k mod EXACT_SUB_LAST;
+     * UINT32_MAX: none, as after a reset) */
     exact_region last[EXACT_SUB_LAST];
     uint32_t last_k[EXACT_SUB_LAST];
-    uint64_t last_gen[EXACT_SUB_LAST];
     uint64_t made, resets; /* statistics: sub-cells made, times emptied */
 } exact_sub_cache;
 

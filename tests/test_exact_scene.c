@@ -381,6 +381,69 @@ static void test_fast_vs_fallback(void **state)
                      centre, 0.5, 0);
 }
 
+/* What a ray finds depends on that ray alone, not on what its worker
+ * traced before (the worker keeps the last ray's line, models, curvature
+ * bounds and sub-cells): rays traced by one worker one after another, each
+ * twice in a row and the one before it again after it, give bit for bit the
+ * hits a fresh worker gives each of them alone, with every traversal
+ * implementation; on two surfaces, one with creases (sub-cells there). */
+static int same_hit(const trace_hit *a, const trace_hit *b)
+{
+    if (a->hit != b->hit)
+        return 0;
+    return !a->hit || (!memcmp(&a->t, &b->t, sizeof a->t) && a->surface == b->surface &&
+                       !memcmp(a->normal, b->normal, sizeof a->normal));
+}
+
+static void test_ray_alone(void **state)
+{
+    (void)state;
+    exact_built b;
+    exact_built_make("bounds -1.1 -1.1 -1.1 1.1 1.1 1.1\n"
+                     "surface max(max(abs(x), abs(y), abs(z)) - 0.8, x^2 + y^2 + z^2 - 1.0,"
+                     " 0.16 - min(x^2 + y^2, y^2 + z^2, z^2 + x^2))\n"
+                     "surface (x - 0.3)^2 + y^2 + (z - 0.5)^2 - 0.2\n",
+                     7, EXACT_CELL_DEPTH, &b);
+    enum { N = 32 };
+    camera cam;
+    look(&cam, eye_std, centre, N);
+    for (unsigned m = 0; m < trace_impl_count; m++) {
+        static trace_hit alone[N * N];
+        double dirs[N * N][3];
+        unsigned hits = 0;
+        for (uint32_t k = 0; k < N * N; k++) {
+            camera_ray(&cam, k % N, k / N, dirs[k]);
+            exact_worker f;
+            assert_int_equal(exact_worker_init(&f, &b.es), 0);
+            const trace_opts fo = {b.tree->levels, 0, &f};
+            trace_ray r;
+            alone[k].hit = 0;
+            if (trace_setup(b.tree, cam.eye, dirs[k], &r))
+                trace_impls[m].traverse(b.tree, &fo, &r, NULL, &alone[k]);
+            hits += (unsigned)alone[k].hit;
+            exact_worker_free(&f);
+        }
+        assert_true(hits > N * N / 4);
+        exact_worker w;
+        assert_int_equal(exact_worker_init(&w, &b.es), 0);
+        const trace_opts o = {b.tree->levels, 0, &w};
+        for (uint32_t k = 0; k < N * N; k++)
+            for (unsigned rep = 0; rep < 3; rep++) {
+                const uint32_t q = rep == 2 && k ? k - 1 : k;
+                trace_ray r;
+                trace_hit h;
+                h.hit = 0;
+                if (trace_setup(b.tree, cam.eye, dirs[q], &r))
+                    trace_impls[m].traverse(b.tree, &o, &r, NULL, &h);
+                if (!same_hit(&h, &alone[q]))
+                    fail_msg("%s: ray %u (pass %u): t %.17g, alone %.17g",
+                             trace_impls[m].name, q, rep, h.t, alone[q].t);
+            }
+        exact_worker_free(&w);
+    }
+    exact_built_free(&b);
+}
+
 /* The coarse cells: a far surface is no candidate in a cell it cannot
  * reach, and a long sum of far blobs is pruned to a few instructions. */
 static void test_cells_prune(void **state)
@@ -424,6 +487,7 @@ int main(void)
         cmocka_unit_test(test_impls_agree),
         cmocka_unit_test(test_roots_on_faces),
         cmocka_unit_test(test_fast_vs_fallback),
+        cmocka_unit_test(test_ray_alone),
         cmocka_unit_test(test_cells_prune),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
