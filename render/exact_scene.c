@@ -332,6 +332,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         a = -r->t_base; /* the caller's t >= 0 */
     double best = INFINITY;
     tape win; /* the winner's exact tape */
+    double win_grad[3] = {NAN}; /* its gradient from the fast path, if any */
     uint32_t best_k = 0;
     if (es->sub_max)
         exact_sub_reserve(&w->sub);
@@ -355,7 +356,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             key = rg->key;
         }
         const double curv = exact_fast_curv(hmag, l.d);
-        double t = INFINITY;
+        double t = INFINITY, grad[3]; /* (set when st is EXACT_FAST_ROOT) */
         int st = EXACT_FAST_UNDECIDED;
         const uint32_t j = k - es->first[slot];
         if (curv < INFINITY && j < EXACT_MODELS) {
@@ -363,7 +364,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             const exact_bound *cb =
                 key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
             st = exact_fast_root(t_exact, &w->scratch, &l, a, b, curv, cb, &w->model[j], &have,
-                                 &t);
+                                 &t, grad);
             w->have = (w->have & ~(UINT32_C(1) << j)) | (uint32_t)have << j;
             w->model_key[j] = key;
         }
@@ -377,6 +378,9 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             best = t;
             best_k = k;
             win = *t_exact;
+            win_grad[0] = NAN;
+            if (st == EXACT_FAST_ROOT)
+                memcpy(win_grad, grad, sizeof grad);
             b = t; /* a later surface must be nearer to win */
         }
     }
@@ -385,7 +389,10 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
     double p[3];
     for (int k = 0; k < 3; k++)
         p[k] = l.o[k] + best * l.d[k];
-    exact_normal(&win, &w->scratch, p, l.d, hit->normal);
+    if (win_grad[0] == win_grad[0])
+        exact_normal_of(win_grad, l.d, hit->normal);
+    else
+        exact_normal(&win, &w->scratch, p, l.d, hit->normal);
     hit->exact = 1;
     hit->surface = es->cand[best_k].surface;
     *t_hit = best;
