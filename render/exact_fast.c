@@ -50,14 +50,20 @@ static void line_point(const exact_line *l, double x, double p[3], double ep[3])
  * model's a-priori bound where p lies in its box too (then the segment
  * between them does, and f's gradient and g''s over the box carry the
  * input error: |f(p) - f(P)| <= sum grad_k ep_k, |g'(p) - g'(P)| <= sum
- * ep_k hd_k), else tape_eval_dir_err. 1, or 0: no bound. */
+ * ep_k hd_k), else tape_eval_dir_err. With grad (may be NULL): f's gradient
+ * at p from the same pass where the a-priori bound is used, else grad[0] =
+ * NaN. 1, or 0: no bound. */
 static int eval_bounded(const tape *t, exact_scratch *w, const exact_line *l,
-                        const exact_model *md, const double p[3], const double ep[3], tape_edir *e)
+                        const exact_model *md, const double p[3], const double ep[3], tape_edir *e,
+                        double grad[3])
 {
     const exact_bound *cb = md->cb;
+    if (grad)
+        grad[0] = NAN;
     if (cb && p[0] >= cb->box[0].lo && p[0] <= cb->box[0].hi && p[1] >= cb->box[1].lo &&
         p[1] <= cb->box[1].hi && p[2] >= cb->box[2].lo && p[2] <= cb->box[2].hi) {
-        e->v = tape_eval_dir(t, p, l->d, &e->d, w->dir);
+        e->v = grad ? tape_eval_dir_grad(t, p, l->d, &e->d, grad, w->dirg)
+                    : tape_eval_dir(t, p, l->d, &e->d, w->dir);
         if (!(fabs(e->v) <= 0x1p100 && fabs(e->d) <= 0x1p100))
             return 0;
         e->ev = (cb->e.ev + cb->e.grad[0] * ep[0] + cb->e.grad[1] * ep[1] +
@@ -78,9 +84,11 @@ static int eval_bounded(const tape *t, exact_scratch *w, const exact_line *l,
  * g'(xi) by the mean value theorem: t* lies in x - [v +- ev] / [d +- dr]
  * (outward-rounded intervals), intersected with [a, b]. Accepted once that
  * enclosure is no wider than EXACT_FAST_BAND; *root is the Newton point
- * clamped into it. 1, or 0: undecided. */
+ * clamped into it, grad f at x from that evaluation (eval_bounded). 1, or 0:
+ * undecided. */
 static int place(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                 int sg, double K, double dmin, const exact_model *md, double *root)
+                 int sg, double K, double dmin, const exact_model *md, double *root,
+                 double grad[3])
 {
     double x = clamp(md->m - md->v / md->d, a, b); /* (NaN: a) */
     double err = K * (x - md->m) * (x - md->m) / (2.0 * dmin);
@@ -99,7 +107,7 @@ static int place(const tape *t, exact_scratch *w, const exact_line *l, double a,
             continue;
         }
         tape_edir e;
-        if (!eval_bounded(t, w, l, md, p, ep, &e))
+        if (!eval_bounded(t, w, l, md, p, ep, &e, grad))
             return 0;
         const double rho = (fabs(e.v) + e.ev) / dmin * CM;
         const double dr = (e.ed + K * rho) * CM;
@@ -142,7 +150,7 @@ int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, doubl
         model->hd[2] = (M[TAPE_HXZ] * ax + M[TAPE_HYZ] * ay + M[TAPE_HZZ] * az) * CM;
     }
     tape_edir e;
-    if (!eval_bounded(t, w, l, model, p, ep, &e))
+    if (!eval_bounded(t, w, l, model, p, ep, &e, NULL))
         return 0;
     model->v = e.v;
     model->d = e.d;
@@ -162,7 +170,7 @@ static inline int classify(const exact_model *model, double a, double b, double 
      * (1 + u) on the span (m may lie outside it) */
     const double m = model->m;
     const double sa = a - m, sb = b - m;
-    const double r = fmax(fabs(sa), fabs(sb));
+    const double r = fabs(sa) > fabs(sb) ? fabs(sa) : fabs(sb); /* (finite; not libm's fmax) */
     const double bd = (model->ed + K * r) * CM;
     *sg = model->d > bd ? 1 : model->d < -bd ? -1 : 0;
     if (!*sg) {
@@ -181,14 +189,14 @@ static inline int classify(const exact_model *model, double a, double b, double 
 }
 
 int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                      double curv, const exact_model *model, double *root)
+                      double curv, const exact_model *model, double *root, double grad[3])
 {
     int sg;
     double dmin;
     const int st = classify(model, a, b, curv, &sg, &dmin);
     if (st != ONE_ROOT)
         return st;
-    return place(t, w, l, a, b, sg, curv, dmin, model, root) ? EXACT_FAST_ROOT
+    return place(t, w, l, a, b, sg, curv, dmin, model, root, grad) ? EXACT_FAST_ROOT
                                                              : EXACT_FAST_UNDECIDED;
 }
 
@@ -212,12 +220,12 @@ static int worth_retry(const exact_model *model, double a, double b, double K)
  * per-point one; `retry`: this is such a second try already. */
 static int fresh(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                  double curv, const exact_bound *cb, double m, int retry, exact_model *model,
-                 int *have, double *root)
+                 int *have, double *root, double grad[3])
 {
     if (cb) {
         *have = exact_fast_model(t, w, l, m, cb, model);
         if (*have) {
-            const int st = exact_fast_decide(t, w, l, a, b, curv, model, root);
+            const int st = exact_fast_decide(t, w, l, a, b, curv, model, root, grad);
             if (st != EXACT_FAST_UNDECIDED || !worth_retry(model, a, b, curv))
                 return st;
         }
@@ -225,7 +233,7 @@ static int fresh(const tape *t, exact_scratch *w, const exact_line *l, double a,
         retry = 1;
     }
     *have = exact_fast_model(t, w, l, m, NULL, model);
-    const int st = *have ? exact_fast_decide(t, w, l, a, b, curv, model, root)
+    const int st = *have ? exact_fast_decide(t, w, l, a, b, curv, model, root, grad)
                          : EXACT_FAST_UNDECIDED;
     if (retry && st != EXACT_FAST_UNDECIDED)
         w->nrescue++;
@@ -234,12 +242,12 @@ static int fresh(const tape *t, exact_scratch *w, const exact_line *l, double a,
 
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                     double curv, const exact_bound *cb, exact_model *model, int *have,
-                    double *root)
+                    double *root, double grad[3])
 {
     if (!(curv < INFINITY))
         return EXACT_FAST_UNDECIDED;
     if (*have) {
-        const int st = exact_fast_decide(t, w, l, a, b, curv, model, root);
+        const int st = exact_fast_decide(t, w, l, a, b, curv, model, root, grad);
         if (st != EXACT_FAST_UNDECIDED)
             return st;
         if (model->m >= a && model->m <= b) {
@@ -247,8 +255,8 @@ int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double
             if (!model->cb || !worth_retry(model, a, b, curv))
                 return EXACT_FAST_UNDECIDED;
             w->nretry++;
-            return fresh(t, w, l, a, b, curv, NULL, model->m, 1, model, have, root);
+            return fresh(t, w, l, a, b, curv, NULL, model->m, 1, model, have, root, grad);
         }
     }
-    return fresh(t, w, l, a, b, curv, cb, 0.5 * (a + b), 0, model, have, root);
+    return fresh(t, w, l, a, b, curv, cb, 0.5 * (a + b), 0, model, have, root, grad);
 }

@@ -58,15 +58,17 @@ int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, doubl
  * *root when g is certified monotone on [a, b] with certified opposite
  * signs at the ends (so exactly one root t*), and *root lies in a certified
  * enclosure of t* no wider than the noise band of g's double evaluation
- * there (EXACT_FAST_BAND: four times its error bound over |g'|, and 4 ulps);
- * otherwise EXACT_FAST_UNDECIDED. */
+ * there (EXACT_FAST_BAND: four times its error bound over |g'|, and 4 ulps),
+ * and in grad f's gradient from the evaluation that placed it (at the point
+ * that the last Newton step, within the enclosure, moved to *root; grad[0]
+ * NaN when that evaluation gave none); otherwise EXACT_FAST_UNDECIDED. */
 /* The width of a root's enclosure that counts as converged: four times the
  * value's error bound over |g'| (twice the noise band's width), plus 4 ulps
  * of t. */
 #define EXACT_FAST_BAND(ev_over_dg, ulp) (4.0 * (ev_over_dg) + 4.0 * (ulp))
 
 int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                      double curv, const exact_model *model, double *root);
+                      double curv, const exact_model *model, double *root, double grad[3]);
 
 /* exact_fast_decide with the caller's model (*have: it holds one, for this
  * line and a box as above) if that decides; else, unless the model's m is
@@ -78,6 +80,6 @@ int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, doub
  * interval.) */
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                     double curv, const exact_bound *cb, exact_model *model, int *have,
-                    double *root);
+                    double *root, double grad[3]);
 
 #endif

@@ -18,11 +18,12 @@ int exact_scratch_init(exact_scratch *w, uint32_t n)
     w->dslots = malloc(n * sizeof *w->dslots);
     w->idir = malloc(n * sizeof *w->idir);
     w->dir = malloc(n * sizeof *w->dir);
+    w->dirg = malloc(n * sizeof *w->dirg);
     w->edir = malloc(n * sizeof *w->edir);
     w->cerr = malloc(n * sizeof *w->cerr);
     w->nbound = w->nretry = w->nrescue = 0;
-    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir || !w->edir ||
-        !w->cerr) {
+    if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir || !w->dirg ||
+        !w->edir || !w->cerr) {
         exact_scratch_free(w);
         return -1;
     }
@@ -37,12 +38,14 @@ void exact_scratch_free(exact_scratch *w)
     free(w->dslots);
     free(w->idir);
     free(w->dir);
+    free(w->dirg);
     free(w->edir);
     free(w->cerr);
     w->cerr = NULL;
     w->edir = NULL;
     w->idir = NULL;
     w->dir = NULL;
+    w->dirg = NULL;
     w->slots = NULL;
     w->islots = NULL;
     w->gslots = NULL;
@@ -195,15 +198,6 @@ void exact_normal(const tape *t, exact_scratch *w, const double p[3], const doub
 {
     double g[3];
     tape_eval_grad(t, p, g, w->dslots);
-    const double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    if (!(len > 0.0) || !isfinite(len)) { /* singular point: face the viewer */
-        const double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        for (int a = 0; a < 3; a++)
-            n[a] = -d[a] / dl;
-        return;
-    }
-    const double facing = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
-    const double sgn = facing > 0.0 ? -1.0 : 1.0;
-    for (int a = 0; a < 3; a++)
-        n[a] = sgn * g[a] / len;
+    exact_normal_of(g, d, n);
 }
+

@@ -5,6 +5,7 @@
 #ifndef EXACT_HIT_H
 #define EXACT_HIT_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "common/expr/tape.h"
@@ -26,6 +27,7 @@ typedef struct exact_scratch {
     tape_dual *dslots;
     tape_idir1 *idir; /* the fast path's (render/exact_fast.c) */
     tape_dir1 *dir;
+    tape_dir4 *dirg; /* the fast path's final evaluation, with the gradient */
     tape_edir *edir;
     tape_cerr *cerr;       /* tape_err_cell's */
     /* statistics: evaluations with an a-priori bound; models whose a-priori
@@ -94,5 +96,20 @@ double exact_first_root(const tape *t, const tape *cull, exact_scratch *w, const
  * -d/|d| where the gradient is zero or not finite. */
 void exact_normal(const tape *t, exact_scratch *w, const double p[3], const double d[3],
                   double n[3]);
+/* The same from a gradient g already at hand (inline: once per hit). */
+static inline void exact_normal_of(const double g[3], const double d[3], double n[3])
+{
+    const double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (!(len > 0.0) || !isfinite(len)) { /* singular point: face the viewer */
+        const double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; a++)
+            n[a] = -d[a] / dl;
+        return;
+    }
+    const double facing = g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+    const double sgn = facing > 0.0 ? -1.0 : 1.0;
+    for (int a = 0; a < 3; a++)
+        n[a] = sgn * g[a] / len;
+}
 
 #endif

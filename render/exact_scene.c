@@ -324,14 +324,19 @@ static __attribute__((noinline)) void make_line(exact_worker *w, const trace_ray
 
 /* The hit at local t of the surface whose exact tape is t: its normal and
  * surface (out of line: most voxels tested hold no root). */
-static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t, double best,
+static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t,
+                                                 const double grad[3], double best,
                                                  uint32_t surface, trace_hit *hit)
 {
     const exact_line *l = &w->line;
-    double p[3];
-    for (int k = 0; k < 3; k++)
-        p[k] = l->o[k] + best * l->d[k];
-    exact_normal(t, &w->scratch, p, l->d, hit->normal);
+    if (grad[0] == grad[0]) { /* the fast path's final evaluation gave it */
+        exact_normal_of(grad, l->d, hit->normal);
+    } else {
+        double p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = l->o[k] + best * l->d[k];
+        exact_normal(t, &w->scratch, p, l->d, hit->normal);
+    }
     hit->exact = 1;
     hit->surface = surface;
 }
@@ -366,6 +371,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         a = -r->t_base; /* the caller's t >= 0 */
     double best = INFINITY;
     tape win; /* the winner's exact tape */
+    double win_grad[3] = {NAN}; /* its gradient from the fast path, if any */
     uint32_t best_k = 0;
     int reserved = 0; /* exact_sub_reserve called for this voxel */
     const uint32_t k0 = es->first[slot], k1 = es->first[slot + 1];
@@ -392,7 +398,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             hmag = rg->hmag;
             key = rg->key;
         }
-        double t = INFINITY;
+        double t = INFINITY, grad[3]; /* (set when st is EXACT_FAST_ROOT) */
         int st = EXACT_FAST_UNDECIDED;
         const uint32_t j = k - k0;
         if (j < EXACT_MODELS) {
@@ -408,7 +414,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
                 const exact_bound *cb =
                     key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
                 st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, &w->model[j],
-                                     &have, &t);
+                                     &have, &t, grad);
                 w->have = (w->have & ~bit) | (uint32_t)have << j;
                 w->model_key[j] = key;
             }
@@ -423,12 +429,15 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             best = t;
             best_k = k;
             win = *t_exact;
+            win_grad[0] = NAN;
+            if (st == EXACT_FAST_ROOT)
+                memcpy(win_grad, grad, sizeof grad);
             b = t; /* a later surface must be nearer to win */
         }
     }
     if (!(best < INFINITY))
         return 0;
-    finish_hit(w, &win, best, es->cand[best_k].surface, hit);
+    finish_hit(w, &win, win_grad, best, es->cand[best_k].surface, hit);
     *t_hit = best;
     return 1;
 }

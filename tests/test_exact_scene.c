@@ -285,6 +285,7 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
     camera cam;
     look(&cam, eye_std, target, 64);
     unsigned hits = 0, same = 0;
+    double dn_max = 0.0;
     for (unsigned k = 0; k < 64 * 64 + 5 * 400; k++) {
         double eye[3], dir[3];
         if (k < 64 * 64) {
@@ -335,19 +336,24 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
             continue;
         hits++;
         /* (two local roots a few ulps apart may give one t on the caller's ray) */
-        if (h1.t == h2.t && !memcmp(h1.normal, h2.normal, sizeof h1.normal)) {
+        if (h1.t == h2.t) {
             same++;
             assert_int_equal(h1.surface, h2.surface);
-            continue;
-        }
-        if (!(fabs(h1.t - h2.t) <= 0x1p-46 * h1.t)) /* (64 ulps at most) */
+        } else if (!(fabs(h1.t - h2.t) <= 0x1p-46 * h1.t)) { /* (64 ulps at most) */
             fail_msg("%s: ray %u: t %.17g, fallback %.17g", text, k, h1.t, h2.t);
-        for (int a = 0; a < 3; a++)
-            assert_true(fabs((double)h1.normal[a] - (double)h2.normal[a]) <= 1e-9);
+        }
+        /* the fast path's normal is f's gradient at its last evaluation, one
+         * Newton step from its t inside the root's enclosure (at most 5.2e-8
+         * apart on these scenes); the fallback's at its t */
+        for (int a = 0; a < 3; a++) {
+            const double dn = fabs((double)h1.normal[a] - (double)h2.normal[a]);
+            dn_max = dn > dn_max ? dn : dn_max;
+            assert_true(dn <= 1e-6);
+        }
     }
     if (getenv("EXACT_VERBOSE"))
-        printf("%u hits, %u the same; fast %llu, slow %llu; a-priori bound %llu, retried "
-               "%llu, rescued %llu\n", hits, same, (unsigned long long)w1.fast,
+        printf("%u hits, %u the same (normals at most %.3g apart); fast %llu, slow %llu; a-priori bound %llu, retried "
+               "%llu, rescued %llu\n", hits, same, dn_max, (unsigned long long)w1.fast,
                (unsigned long long)w1.slow, (unsigned long long)w1.scratch.nbound,
                (unsigned long long)w1.scratch.nretry, (unsigned long long)w1.scratch.nrescue);
     if (bounded)

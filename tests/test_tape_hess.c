@@ -8,6 +8,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 #include <cmocka.h>
 
 #include "common/expr/tape_dir.h"
@@ -164,9 +165,17 @@ static void test_hess_off(void **state)
     }
 }
 
+/* Bit for bit, or both NaN (whose sign bits -x and x * -1 may set apart). */
+static int same_double(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0 || (a != a && b != b);
+}
+
 /* The directional evaluators on t over box along d: the point one's value
- * is bit for bit tape_eval's, and where `compare` its derivative is grad .
- * d of tape_eval_grad to rounding; the interval one's value enclosure is
+ * is bit for bit tape_eval's, tape_eval_dir_grad's value and derivative are
+ * tape_eval_dir's and its gradient tape_eval_grad's (bit for bit, or both
+ * NaN), and where `compare` the derivative is grad . d of tape_eval_grad to
+ * rounding; the interval one's value enclosure is
  * tape_eval_interval's (its flags at least those) and, unflagged, its
  * derivative encloses the point one's.
  * Returns the number of points whose derivative was enclosed. */
@@ -176,6 +185,7 @@ static unsigned check_dir(const tape *t, const interval box[3], const double d[3
     static tape_dir1 ds[MAXSLOTS];
     static tape_idir1 ids[MAXSLOTS];
     static tape_dual gs[MAXSLOTS];
+    static tape_dir4 d4[MAXSLOTS];
     static interval is[MAXSLOTS];
     static double slots[MAXSLOTS];
     interval D;
@@ -191,8 +201,15 @@ static unsigned check_dir(const tape *t, const interval box[3], const double d[3
         const double v = tape_eval_dir(t, p, d, &dv, ds);
         const double v0 = tape_eval(t, p[0], p[1], p[2], slots);
         assert_memory_equal(&v, &v0, sizeof v);
+        double dv4, grad4[3];
+        const double v4 = tape_eval_dir_grad(t, p, d, &dv4, grad4, d4);
+        tape_eval_grad(t, p, grad, gs);
+        assert_true(same_double(v4, v) && same_double(dv4, dv));
+        for (int a = 0; a < 3; a++)
+            if (!same_double(grad4[a], grad[a]))
+                fail_msg("%s: tape_eval_dir_grad's partial %d %.17g, tape_eval_grad's %.17g", what,
+                         a, grad4[a], grad[a]);
         if (compare) {
-            tape_eval_grad(t, p, grad, gs);
             const double ref = grad[0] * d[0] + grad[1] * d[1] + grad[2] * d[2];
             const double scale =
                 fabs(grad[0] * d[0]) + fabs(grad[1] * d[1]) + fabs(grad[2] * d[2]);

@@ -9,8 +9,12 @@
 
 /* A value and its directional derivative. */
 typedef struct tape_dir1 {
-    double v, d;
+    double v, d[1];
 } tape_dir1;
+/* A value, its directional derivative (d[0]) and its gradient (d[1..3]). */
+typedef struct tape_dir4 {
+    double v, d[4];
+} tape_dir4;
 typedef struct tape_idir1 {
     interval v, d;
 } tape_idir1;
@@ -20,6 +24,12 @@ typedef struct tape_idir1 {
  * min, max: the branch taken). `slots`: t->n elements. */
 double tape_eval_dir(const tape *t, const double p[3], const double d[3], double *deriv,
                      tape_dir1 *slots);
+
+/* tape_eval_dir's value and *deriv, bit for bit, and in the same pass
+ * grad[3], bit for bit tape_eval_grad's at p (the same rules on each
+ * tangent). `slots`: t->n elements. */
+double tape_eval_dir_grad(const tape *t, const double p[3], const double d[3], double *deriv,
+                          double grad[3], tape_dir4 *slots);
 
 /* Enclosures over the box: of f (as tape_eval_interval's, *deriv aside) and
  * of grad f . d at every point of the box where f is defined and

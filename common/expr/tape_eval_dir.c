@@ -1,60 +1,46 @@
 /* tape_eval_dir: f with its derivative along one direction, at a point
- * (double) and over a box (intervals); see tape_dir.h. The rules are those
- * of tape_eval_grad and tape_eval_interval_grad with one tangent instead of
- * three. */
+ * (double, also with the gradient) and over a box (intervals); see
+ * tape_dir.h. The rules are those of tape_eval_grad and
+ * tape_eval_interval_grad with one tangent (four) instead of three. */
 #include "common/expr/tape_dir.h"
 
 #include "common/expr/tape_int.h"
 
+#define N 1
+#define FN eval_dir1
+#define SLOT tape_dir1
+#include "common/expr/tape_dir_body.h"
+#undef N
+#undef FN
+#undef SLOT
+
+#define N 4
+#define FN eval_dir4
+#define SLOT tape_dir4
+#include "common/expr/tape_dir_body.h"
+#undef N
+#undef FN
+#undef SLOT
+
 double tape_eval_dir(const tape *t, const double p[3], const double d[3], double *deriv,
                      tape_dir1 *s)
 {
-    const tape_insn *in = t->insn;
-    const tape_const *k = t->konst;
-    for (uint32_t i = 0, n = t->n; i < n; i++) {
-        tape_dir1 *r = &s[i];
-        /* operands: only the ops that have them name them (as tape_eval) */
-#define OA s[in[i].a]
-#define OC s[in[i].b]
-        switch ((tape_op)in[i].op) {
-        case TAPE_CONST: r->v = k[in[i].a].v; r->d = 0.0; break;
-        case TAPE_X: case TAPE_Y: case TAPE_Z:
-            r->v = p[in[i].op - TAPE_X];
-            r->d = d[in[i].op - TAPE_X];
-            break;
-        case TAPE_NEG: r->v = -OA.v; r->d = -OA.d; break;
-        case TAPE_SQUARE: r->v = OA.v * OA.v; r->d = OA.d * (2.0 * OA.v); break;
-        case TAPE_SQRT: r->v = sqrt(OA.v); r->d = OA.d * (0.5 / r->v); break;
-        case TAPE_EXP: r->v = exp(OA.v); r->d = OA.d * r->v; break;
-        case TAPE_LOG: r->v = log(OA.v); r->d = OA.d * (1.0 / OA.v); break;
-        case TAPE_ABS: r->v = fabs(OA.v); r->d = OA.v < 0.0 ? -OA.d : OA.d; break;
-        case TAPE_SIN: { double sv, cv; point_sincos(OA.v, &sv, &cv); r->v = sv; r->d = OA.d * cv; break; }
-        case TAPE_COS: { double sv, cv; point_sincos(OA.v, &sv, &cv); r->v = cv; r->d = OA.d * -sv; break; }
-        case TAPE_TAN: r->v = tan(OA.v); r->d = OA.d * (1.0 + r->v * r->v); break;
-        case TAPE_ADD: r->v = OA.v + OC.v; r->d = OA.d + OC.d; break;
-        case TAPE_SUB: r->v = OA.v - OC.v; r->d = OA.d - OC.d; break;
-        case TAPE_MUL: r->v = OA.v * OC.v; r->d = OA.d * OC.v + OA.v * OC.d; break;
-        case TAPE_DIV: r->v = OA.v / OC.v; r->d = (OA.d - r->v * OC.d) / OC.v; break;
-        case TAPE_MIN:
-        case TAPE_MAX: {
-            const double v = in[i].op == TAPE_MIN ? point_min(OA.v, OC.v) : point_max(OA.v, OC.v);
-            r->d = (v == OA.v || v != v) ? OA.d : OC.d;
-            r->v = v;
-            break;
-        }
-        case TAPE_POWC: {
-            const double e = k[in[i].b].v;
-            r->v = pow(OA.v, e);
-            r->d = OA.d * (e * pow(OA.v, e - 1.0));
-            break;
-        }
-        case TAPE_NOPS: r->v = NAN; r->d = NAN; break;
-        }
-#undef OA
-#undef OC
-    }
-    *deriv = s[t->root].d;
-    return s[t->root].v;
+    const double seed[3][1] = {{d[0]}, {d[1]}, {d[2]}};
+    const double v = eval_dir1(t, p, seed, s);
+    *deriv = s[t->root].d[0];
+    return v;
+}
+
+double tape_eval_dir_grad(const tape *t, const double p[3], const double d[3], double *deriv,
+                          double grad[3], tape_dir4 *s)
+{
+    /* tangent 0 along d (tape_eval_dir's), 1 to 3 along the axes */
+    const double seed[3][4] = {{d[0], 1.0, 0.0, 0.0}, {d[1], 0.0, 1.0, 0.0}, {d[2], 0.0, 0.0, 1.0}};
+    const double v = eval_dir4(t, p, seed, s);
+    *deriv = s[t->root].d[0];
+    for (int k = 0; k < 3; k++)
+        grad[k] = s[t->root].d[1 + k];
+    return v;
 }
 
 static int is_zero(interval a) { return a.lo == 0.0 && a.hi == 0.0; }

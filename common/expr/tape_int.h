@@ -57,6 +57,15 @@ static inline unsigned trig_memo_entry(trig_memo *m, uint32_t a, interval x, uns
     return j;
 }
 
+/* The default of a switch over a tape's op codes: a tape holds none but
+ * tape_op's (the builder makes none else, and the reader refuses unknown
+ * codes: format/oct_function.c), so the compiler may drop its range test. */
+#if defined(__GNUC__)
+#define TAPE_OP_NONE() __builtin_unreachable()
+#else
+#define TAPE_OP_NONE() ((void)0)
+#endif
+
 /* Operand slots of an instruction, 0 where the field is not a slot (a
  * constant-pool index, or unused), so that no pointer is formed outside
  * the caller's slot array. */

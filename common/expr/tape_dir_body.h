@@ -1,0 +1,130 @@
+/* tape_dir_body.h: forward-mode AD in double with N tangents, the rules of
+ * tape_eval_grad (abs, min, max: the branch taken), included by
+ * tape_eval_dir.c once per N with FN its name and SLOT its slot type (v,
+ * d[N]). seed[k] is the tangent of coordinate k; every tangent follows the
+ * same operations, so one tangent seeded with a direction is, bit for bit,
+ * the same whatever the others are. */
+#define TANGENTS for (unsigned j = 0; j < N; j++)
+
+static inline double FN(const tape *t, const double p[3], const double seed[3][N], SLOT *s)
+{
+    const tape_insn *in = t->insn;
+    const tape_const *k = t->konst;
+    for (uint32_t i = 0, n = t->n; i < n; i++) {
+        SLOT *r = &s[i];
+        /* operands: only the ops that have them name them (as tape_eval) */
+#define OA s[in[i].a]
+#define OC s[in[i].b]
+        switch ((tape_op)in[i].op) {
+        case TAPE_CONST: r->v = k[in[i].a].v; TANGENTS r->d[j] = 0.0; break;
+        case TAPE_X: case TAPE_Y: case TAPE_Z: {
+            const uint32_t ax = in[i].op - TAPE_X;
+            r->v = p[ax];
+            TANGENTS r->d[j] = seed[ax][j];
+            break;
+        }
+        case TAPE_NEG: r->v = -OA.v; TANGENTS r->d[j] = -OA.d[j]; break;
+        case TAPE_SQUARE: {
+            const double a = OA.v, m = 2.0 * a;
+            TANGENTS r->d[j] = OA.d[j] * m;
+            r->v = a * a;
+            break;
+        }
+        case TAPE_SQRT: {
+            const double v = sqrt(OA.v), m = 0.5 / v;
+            TANGENTS r->d[j] = OA.d[j] * m;
+            r->v = v;
+            break;
+        }
+        case TAPE_EXP: {
+            const double v = exp(OA.v);
+            TANGENTS r->d[j] = OA.d[j] * v;
+            r->v = v;
+            break;
+        }
+        case TAPE_LOG: {
+            const double a = OA.v, m = 1.0 / a;
+            TANGENTS r->d[j] = OA.d[j] * m;
+            r->v = log(a);
+            break;
+        }
+        case TAPE_ABS: {
+            const double a = OA.v;
+            if (a < 0.0)
+                TANGENTS r->d[j] = -OA.d[j];
+            else
+                TANGENTS r->d[j] = OA.d[j];
+            r->v = fabs(a);
+            break;
+        }
+        case TAPE_SIN: {
+            double sv, cv;
+            point_sincos(OA.v, &sv, &cv);
+            TANGENTS r->d[j] = OA.d[j] * cv;
+            r->v = sv;
+            break;
+        }
+        case TAPE_COS: {
+            double sv, cv;
+            point_sincos(OA.v, &sv, &cv);
+            const double m = -sv;
+            TANGENTS r->d[j] = OA.d[j] * m;
+            r->v = cv;
+            break;
+        }
+        case TAPE_TAN: {
+            const double v = tan(OA.v), m = 1.0 + v * v;
+            TANGENTS r->d[j] = OA.d[j] * m;
+            r->v = v;
+            break;
+        }
+        case TAPE_ADD: {
+            const double v = OA.v + OC.v;
+            TANGENTS r->d[j] = OA.d[j] + OC.d[j];
+            r->v = v;
+            break;
+        }
+        case TAPE_SUB: {
+            const double v = OA.v - OC.v;
+            TANGENTS r->d[j] = OA.d[j] - OC.d[j];
+            r->v = v;
+            break;
+        }
+        case TAPE_MUL: {
+            const double a = OA.v, c = OC.v;
+            TANGENTS r->d[j] = OA.d[j] * c + a * OC.d[j];
+            r->v = a * c;
+            break;
+        }
+        case TAPE_DIV: {
+            const double c = OC.v, v = OA.v / c;
+            TANGENTS r->d[j] = (OA.d[j] - v * OC.d[j]) / c;
+            r->v = v;
+            break;
+        }
+        case TAPE_MIN:
+        case TAPE_MAX: {
+            const double a = OA.v;
+            const double v = in[i].op == TAPE_MIN ? point_min(a, OC.v) : point_max(a, OC.v);
+            const SLOT *w = (v == a || v != v) ? &OA : &OC;
+            TANGENTS r->d[j] = w->d[j];
+            r->v = v;
+            break;
+        }
+        case TAPE_POWC: {
+            const double e = k[in[i].b].v, a = OA.v;
+            const double m = e * pow(a, e - 1.0);
+            TANGENTS r->d[j] = OA.d[j] * m;
+            r->v = pow(a, e);
+            break;
+        }
+        case TAPE_NOPS: r->v = NAN; TANGENTS r->d[j] = NAN; break;
+        default: TAPE_OP_NONE();
+        }
+#undef OA
+#undef OC
+    }
+    return s[t->root].v;
+}
+
+#undef TANGENTS
