@@ -149,7 +149,8 @@ $(B)/hooks/%.o: %.c
 # at run time): these files alone get -mavx2 (no FMA), outside link-time
 # optimisation so no other code is compiled for AVX2.
 ifeq ($(ARCH),x86_64)
-$(B)/common/expr/tape_ilanes_avx2.o $(B)/common/expr/tape_lanes_avx2.o: ALLCFLAGS += -mavx2 -fno-lto
+$(B)/common/expr/tape_ilanes_avx2.o $(B)/common/expr/tape_lanes_avx2.o \
+    $(B)/common/expr/tape_iglanes_avx2.o: ALLCFLAGS += -mavx2 -fno-lto
 endif
 
 # --version: VERSION plus the checkout's commit (none outside a checkout).

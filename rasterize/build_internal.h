@@ -130,6 +130,7 @@ typedef struct worker {
     tape_dual *dslots;
     tape_dual_lanes *lslots;
     tape_ilanes *ilslots;  /* the lane interval evaluator's scratch */
+    tape_idual_lanes *iglslots; /* the lane interval gradient evaluator's */
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
@@ -184,11 +185,12 @@ typedef struct retest_item {
  * plain_test_drops: the plain interval test over each cell's box (no point of
  * the surface where f is defined), on voxels or on a node's children. Same
  * decisions and counts as testing the cells one by one. */
-/* 1 when centred_form_drops would keep the voxel (box, centre cv) whatever
- * f at cv is found to be, from the node's form (fc at centre c, G) alone:
- * then f(cv) need not be evaluated for it (an fd of NaN keeps it). */
-int centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
-                                const interval box[3], const double cv[3]);
+/* Bit i set for the children i in cand (their boxes in cb) that
+ * centred_form_drops would keep whatever f at their centres is found to be,
+ * from the node's form (fc at centre c, G) alone: then f there need not be
+ * evaluated (an fd of NaN keeps it). */
+uint8_t centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
+                                    const child_boxes *cb, uint8_t cand);
 void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
                         unsigned n, uint8_t *drop);
 void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,
@@ -203,6 +205,21 @@ void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *
 int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned depth,
                      const uint64_t cell[3], const double fcc[3], interval *fc, interval G[3],
                      int reuse, uint8_t *fx);
+
+/* A node's own mean-value form, as child_enclosures makes it without
+ * reuse: G over its box, fc = f([c]) at its centre; ok 0 where either may
+ * be undefined. */
+typedef struct node_form {
+    interval fc, G[3];
+    int ok;
+} node_form;
+
+/* The forms of n <= TAPE_LANES nodes (boxes box, centres centre) on one
+ * tape, their gradient enclosures in one pass of the lane interval gradient
+ * evaluator, their centres' in one of the lane interval evaluator: the same
+ * bits as child_enclosures makes node by node. */
+void node_forms(worker *wk, const tape *t, unsigned n, interval box[][3],
+                const double centre[][3], node_form *nf);
 
 /* --- voxels (voxel_normal.c) -------------------------------------------- */
 

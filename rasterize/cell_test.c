@@ -68,21 +68,39 @@ static int centred_form_may_exclude(const interval G[3], const interval box[3],
  * >= 0, the form cannot exclude 0: centred_form_drops keeps the voxel
  * whatever f([cv]) is, so its value need not be made. The sums are in plain
  * double with a margin far above their rounding (and above flushed
- * subnormals); a non-finite term gives 0 (evaluate). */
-int centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
-                                const interval box[3], const double cv[3])
+ * subnormals); a non-finite term gives 0 (evaluate). Each axis's term
+ * depends on the child's half of that axis only: the six are made once for
+ * the eight children. */
+uint8_t centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
+                                    const child_boxes *cb, uint8_t cand)
 {
-    double up = fc.hi, lo = fc.lo, mag = fabs(fc.lo) + fabs(fc.hi);
-    for (int k = 0; k < 3; k++) {
-        double d = cv[k] - c[k], rl = box[k].lo - cv[k], rh = box[k].hi - cv[k];
-        double e1 = G[k].lo * d, e2 = G[k].hi * d;
-        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
-        up += max2(e1, e2) + min2(min2(p1, p2), min2(p3, p4));
-        lo += min2(e1, e2) + max2(max2(p1, p2), max2(p3, p4));
-        mag += (fabs(G[k].lo) + fabs(G[k].hi)) * (fabs(d) + fabs(rl) + fabs(rh));
+    double tu[3][2], tl[3][2], tm[3][2];
+    for (int k = 0; k < 3; k++)
+        for (int b = 0; b < 2; b++) {
+            double cv = cb->mid[k][b], d = cv - c[k];
+            double rl = cb->half[k][b].lo - cv, rh = cb->half[k][b].hi - cv;
+            double e1 = G[k].lo * d, e2 = G[k].hi * d;
+            double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
+            tu[k][b] = max2(e1, e2) + min2(min2(p1, p2), min2(p3, p4));
+            tl[k][b] = min2(e1, e2) + max2(max2(p1, p2), max2(p3, p4));
+            tm[k][b] = (fabs(G[k].lo) + fabs(G[k].hi)) * (fabs(d) + fabs(rl) + fabs(rh));
+        }
+    uint8_t m = 0;
+    for (unsigned i = 0; i < 8; i++) {
+        if (!((cand >> i) & 1))
+            continue;
+        const unsigned bit[3] = {i & 1, (i >> 1) & 1, i >> 2};
+        double up = fc.hi, lo = fc.lo, mag = fabs(fc.lo) + fabs(fc.hi);
+        for (int k = 0; k < 3; k++) {
+            up += tu[k][bit[k]];
+            lo += tl[k][bit[k]];
+            mag += tm[k][bit[k]];
+        }
+        double margin = 0x1p-40 * mag + 0x1p-1000;
+        if (up + margin <= 0.0 && lo - margin >= 0.0) /* false on NaN */
+            m |= (uint8_t)(1u << i);
     }
-    double margin = 0x1p-40 * mag + 0x1p-1000;
-    return up + margin <= 0.0 && lo - margin >= 0.0; /* false on NaN */
+    return m;
 }
 
 /* The form itself, from fc = f([c]) and its flags fl. */
@@ -131,6 +149,40 @@ void centred_form_drops(worker *wk, const tape *t, const interval G[3], const re
                                                                it[lane[l]].centre);
             m = 0;
         }
+    }
+}
+
+void node_forms(worker *wk, const tape *t, unsigned n, interval box[][3],
+                const double centre[][3], node_form *nf)
+{
+    interval pts[TAPE_LANES][3], out[TAPE_LANES];
+    unsigned fl[TAPE_LANES], lane[TAPE_LANES], m = 0;
+    interval v[TAPE_LANES];
+    unsigned gf[TAPE_LANES];
+    if (n == 1) /* one alone: the scalar evaluator, the same bits */
+        tape_eval_interval_grad(t, box[0], nf[0].G, wk->islots, &gf[0]);
+    else {
+        interval G[TAPE_LANES][3];
+        tape_eval_interval_grad_lanes(t, n, (const interval(*)[3])box, v, G, gf, wk->iglslots);
+        for (unsigned j = 0; j < n; j++)
+            memcpy(nf[j].G, G[j], sizeof G[j]);
+    }
+    wk->st.gradient_evals += n;
+    for (unsigned j = 0; j < n; j++) {
+        nf[j].ok = 0;
+        if (gf[j])
+            continue;
+        for (int k = 0; k < 3; k++)
+            pts[m][k].lo = pts[m][k].hi = centre[j][k];
+        lane[m++] = j;
+    }
+    if (!m)
+        return;
+    lanes_or_one(wk, t, m, pts, out, fl);
+    wk->st.interval_evals += m;
+    for (unsigned l = 0; l < m; l++) {
+        nf[lane[l]].fc = out[l];
+        nf[lane[l]].ok = !fl[l] && !interval_is_nan(out[l]);
     }
 }
 

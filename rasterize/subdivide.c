@@ -14,7 +14,8 @@ _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradie
  * all this deep, so the cost is paid on coarse grids only. */
 #define MEAN_VALUE_ALONE_DEPTH 8
 
-static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3]);
+static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
+                          const node_form *given);
 
 /* f and its gradient at n voxel centres (tape_eval_grad_lanes). With
  * --shell-only and one surface only f is wanted (the centred re-test's
@@ -32,18 +33,21 @@ static void centre_values(worker *wk, const tape *t, unsigned n, const double *x
     tape_eval_grad_lanes(t, n, x, y, z, f, g, wk->lslots);
 }
 
-/* With --shell-only and one surface, f at child i's centre serves only the
- * centred re-test: where the node's form (fc at centre c, G) shows that the
- * re-test keeps the child whatever f is there, 1 is returned (the re-test is
- * not run, no evaluation) and fg, its entry of cf8, is filled with zeros. */
-static int skip_centre(const worker *wk, interval fc, const interval G[3], const double c[3],
-                       const child_boxes *cb, unsigned i, double fg[4])
+/* With --shell-only and one surface, f at a child's centre serves only the
+ * centred re-test: the candidates (cand) where the node's form (fc at
+ * centre c, G) shows that the re-test keeps the child whatever f is there
+ * are returned (their re-tests are not run, no evaluation), their entries
+ * of cf8 filled with zeros. */
+static uint8_t skip_centres(const worker *wk, interval fc, const interval G[3], const double c[3],
+                            const child_boxes *cb, uint8_t cand, double *cf8)
 {
-    if (!wk->c->par->shell_only || wk->c->nsurf != 1 ||
-        !centred_form_cannot_exclude(fc, G, c, cb->box[i], cb->centre[i]))
+    if (!wk->c->par->shell_only || wk->c->nsurf != 1 || !cand)
         return 0;
-    fg[0] = fg[1] = fg[2] = fg[3] = 0.0;
-    return 1;
+    uint8_t m = centred_form_cannot_exclude(fc, G, c, cb, cand);
+    for (unsigned i = 0; i < 8; i++)
+        if ((m >> i) & 1)
+            memset(cf8 + 4 * i, 0, 4 * sizeof *cf8);
+    return m;
 }
 
 /* For a leaf-parent: f and its gradient at the centres of the children that
@@ -186,10 +190,34 @@ typedef struct leaf_parent {
     unsigned slot; /* which child of its parent */
     interval pbox[3];
     double pc[3];
-    uint8_t ok[1], fx[1], cand, nofd, cf8_have, centred[1], plain[1]; /* nofd: see skip_centre */
+    uint8_t ok[1], fx[1], cand, nofd, cf8_have, centred[1], plain[1]; /* nofd: see skip_centres */
     child_boxes cb;
     double cf8[32];
 } leaf_parent;
+
+/* The n nodes (depth, cell[j], slot[j] of their parent) that the parent's
+ * visit_children let through, of a single-surface scene, on the mean-value
+ * levels above the leaf-parents' parents: they share their parent's tape,
+ * so their own forms (G, f at the centre) are made together (node_forms),
+ * then each is visited in slot order. Returns their mask bits. */
+static uint8_t visit_siblings(worker *wk, unsigned depth, uint64_t cell[][3], const uint8_t *slot,
+                              unsigned n)
+{
+    const build_ctx *c = wk->c;
+    interval box[8][3];
+    double centre[8][3];
+    node_form nf[8];
+    for (unsigned j = 0; j < n; j++)
+        cell_box(c, depth, cell[j], box[j], centre[j]);
+    node_forms(wk, &wk->tapes[depth + 1], n, box, (const double(*)[3])centre, nf);
+    uint8_t mask = 0;
+    for (unsigned j = 0; j < n && !wk->failed; j++) {
+        wk->nact[depth + 1] = 1; /* a later sibling dropped may have cleared it */
+        if (visit_node(wk, depth, cell[j], &nf[j]))
+            mask |= (uint8_t)(1u << slot[j]);
+    }
+    return mask;
+}
 
 /* The children of the node (depth, cell) in slot order, with the node's
  * forms (ok, fx) and boxes (cb) made: their tests, then the voxels' records
@@ -205,7 +233,9 @@ static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3]
     const unsigned ns = c->nsurf, pidx = depth + 1, cidx = depth + 2;
     newton nw[8];
     uint8_t child[8], surf[8], mask = 0, coarse[OCT_MAX_SURFACES];
-    unsigned np = 0;
+    unsigned np = 0, nd = 0;
+    uint64_t dcell[8][3]; /* the siblings deferred to visit_siblings */
+    const int defer = !retest && !batch && ns == 1 && depth + 2 < c->levels;
     children_plain_tests(wk, depth, ok, fx, cb, coarse);
     for (unsigned i = 0; i < 8 && !wk->failed; i++) {
         const interval *box = cb->box[i];
@@ -250,12 +280,17 @@ static uint8_t visit_children(worker *wk, unsigned depth, const uint64_t cell[3]
             leaf_parent *lp = &batch[(*nb)++];
             memcpy(lp->cell, cc, sizeof cc);
             lp->slot = i;
-        } else if (visit_node(wk, depth + 1, cc)) { /* the few children that go on */
+        } else if (defer) {
+            memcpy(dcell[nd], cc, sizeof cc);
+            child[nd++] = (uint8_t)i;
+        } else if (visit_node(wk, depth + 1, cc, NULL)) { /* the few children that go on */
             mask |= (uint8_t)(1u << i);
         }
     }
     if (np)
         emit_voxels(wk, cb, child, surf, nw, np);
+    if (nd && !wk->failed)
+        mask |= visit_siblings(wk, depth + 1, dcell, child, nd);
     return wk->failed ? 0 : mask;
 }
 
@@ -302,7 +337,7 @@ static uint8_t kept_voxels(worker *wk, const leaf_parent *p)
 
 /* For leaf_batch: the leaf-parents' forms (the node's, reused), their
  * candidate voxels, and f and its gradient at the centres of those that
- * need them (not skip_centre's), in passes of TAPE_LANES points. */
+ * need them (not skip_centres'), in passes of TAPE_LANES points. */
 static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
 {
     const build_ctx *c = wk->c;
@@ -321,11 +356,9 @@ static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
         for (unsigned i = 0; i < 8 && p->ok[0]; i++)
             if (!((p->fx[0] >> i) & 1) && child_box(&p->cb, i))
                 p->cand |= (uint8_t)(1u << i);
+        p->nofd = skip_centres(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, p->cand, p->cf8);
         for (unsigned i = 0; i < 8; i++) { /* f and grad f at the candidates' centres */
-            if (((p->cand >> i) & 1) &&
-                skip_centre(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, i, p->cf8 + 4 * i)) {
-                p->nofd |= (uint8_t)(1u << i);
-            } else if ((p->cand >> i) & 1) {
+            if (((p->cand & ~p->nofd) >> i) & 1) {
                 x[n] = p->cb.centre[i][0];
                 y[n] = p->cb.centre[i][1];
                 z[n] = p->cb.centre[i][2];
@@ -449,7 +482,8 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
  * the node's tapes (pruning no longer pays this deep); voxels are emitted,
  * deeper nodes recursed into. Where the mean-value form is not available for
  * a surface (f or its gradient may be undefined), the plain test is used. */
-static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[3])
+static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[3],
+                                const node_form *given)
 {
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
@@ -469,9 +503,16 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
         if (r) {
             memcpy(G, &wk->grad[((size_t)depth * ns + s) * 3], 3 * sizeof *G);
             *fc = wk->fcen[(size_t)depth * ns + s];
+        } else if (given) { /* made with its siblings' (ns == 1) */
+            memcpy(G, given->G, 3 * sizeof *G);
+            *fc = given->fc;
         }
-        ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, depth, cell,
-                                          r ? wk->ncen[depth] : pc, fc, G, r, &fx[k]);
+        if (given && !given->ok)
+            ok[k] = 0;
+        else
+            ok[k] = (uint8_t)child_enclosures(wk, &wk->tapes[(size_t)pidx * ns + s], pbox, depth,
+                                              cell, r ? wk->ncen[depth] : pc, fc, G, r || given,
+                                              &fx[k]);
         wk->grad_ok[(size_t)pidx * ns + s] = ok[k];
     }
     child_boxes cb; /* most children fall to the form alone: boxes are made lazily */
@@ -496,12 +537,13 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
 
 /* Builds the subtree of a cell already tested non-empty; returns its child
  * mask (0 when nothing below it survived). */
-static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
+static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
+                          const node_form *given)
 {
     const build_ctx *c = wk->c;
     uint8_t mask = 0;
     if (depth + MEAN_VALUE_LEVELS >= c->levels && c->par->method == BUILD_INTERVAL) {
-        mask = visit_mean_value(wk, depth, cell);
+        mask = visit_mean_value(wk, depth, cell, given);
     } else {
         for (unsigned i = 0; i < 8 && !wk->failed; i++) {
             uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1),
@@ -511,7 +553,8 @@ static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3])
             if (!shard_meets(c, depth + 1, cc) || /* outside this shard's piece */
                 !cell_test_surviving(wk, depth + 1, depth + 1, cc, box, centre))
                 continue;
-            if (depth + 1 == c->levels ? emit_voxel(wk, box, centre) : visit_node(wk, depth + 1, cc))
+            if (depth + 1 == c->levels ? emit_voxel(wk, box, centre)
+                                       : visit_node(wk, depth + 1, cc, NULL))
                 mask |= (uint8_t)(1u << i);
         }
     }
@@ -538,5 +581,5 @@ void run_task(worker *wk, uint64_t task, task_out *out)
     interval box[3];
     double centre[3];
     if (shard_meets(c, c->task_depth, cell) && cell_test_surviving(wk, 0, c->task_depth, cell, box, centre))
-        out->nonempty = visit_node(wk, c->task_depth, cell) != 0;
+        out->nonempty = visit_node(wk, c->task_depth, cell, NULL) != 0;
 }

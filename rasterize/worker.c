@@ -27,7 +27,8 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->cf8_have = calloc(c->nsurf, 1);
     wk->lslots = malloc(len * sizeof *wk->lslots);
     wk->ilslots = malloc(len * sizeof *wk->ilslots);
-    if (!wk->ilslots || !wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
+    wk->iglslots = malloc(len * sizeof *wk->iglslots);
+    if (!wk->ilslots || !wk->iglslots || !wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
         !wk->prune || !wk->prune_konst || !wk->tapes || !wk->act || !wk->kinked || !wk->nact || !wk->grad ||
         !wk->grad_ok || !wk->fcen || !wk->ncen || !wk->cf || !wk->cf_ok || !wk->cf8 || !wk->cf8_have)
         return -1;
@@ -47,5 +48,5 @@ void worker_free(worker *wk)
     free(wk->nact);
     free(wk->grad); free(wk->grad_ok); free(wk->fcen); free(wk->ncen);
     free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->cf8_have); free(wk->lslots);
-    free(wk->ilslots);
+    free(wk->ilslots); free(wk->iglslots);
 }

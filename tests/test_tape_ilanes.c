@@ -1,6 +1,7 @@
-/* Tests for the lane interval evaluator (common/expr/tape_ilanes.c): on
- * every build the processor can run (portable, AVX2), each lane gives the
- * bits and flags of tape_eval_interval on its box, for random trees of every
+/* Tests for the lane interval evaluators (common/expr/tape_ilanes.c,
+ * tape_iglanes.c): on every build the processor can run (portable, AVX2),
+ * each lane gives the bits and flags of tape_eval_interval (and
+ * tape_eval_interval_grad, gradient included) on its box, for random trees of every
  * operation over boxes that reach the edge cases (points, signed zeros,
  * subnormal and huge ends, infinite ends, overflow), and for the example
  * scenes over the cells of their subdivision. Runs from the repository
@@ -28,6 +29,35 @@ static int same_bits(double a, double b)
 
 static tape_ilanes lslots[MAXSLOTS];
 static interval islots[MAXSLOTS];
+static tape_idual_lanes glslots[MAXSLOTS];
+static tape_idual gslots[MAXSLOTS];
+
+static int same_interval(interval a, interval b)
+{
+    return same_bits(a.lo, b.lo) && same_bits(a.hi, b.hi);
+}
+
+/* The gradient lanes against tape_eval_interval_grad, on the given path. */
+static void check_grad(int path, const tape *t, const interval box[][3], unsigned n,
+                       const char *what)
+{
+    interval out[TAPE_LANES], g[TAPE_LANES][3];
+    unsigned fl[TAPE_LANES];
+    tape_eval_interval_grad_lanes_on(path, t, n, box, out, g, fl, glslots);
+    for (unsigned l = 0; l < n; l++) {
+        unsigned f1 = 0;
+        interval rg[3], r = tape_eval_interval_grad(t, box[l], rg, gslots, &f1);
+        int j = 0;
+        while (j < 3 && same_interval(g[l][j], rg[j]))
+            j++;
+        if (!same_interval(out[l], r) || j < 3 || fl[l] != f1)
+            fail_msg("%s: gradient path %s lane %u of %u, box [%a,%a]x[%a,%a]x[%a,%a]: "
+                     "[%a,%a] flags %u, scalar [%a,%a] flags %u, first partial differing %d",
+                     what, tape_lanes_path_name(path), l, n, box[l][0].lo, box[l][0].hi,
+                     box[l][1].lo, box[l][1].hi, box[l][2].lo, box[l][2].hi, out[l].lo,
+                     out[l].hi, fl[l], r.lo, r.hi, f1, j);
+    }
+}
 
 /* Lane by lane against tape_eval_interval, on the given path. */
 static void check(int path, const tape *t, const interval box[][3], unsigned n, const char *what)
@@ -45,6 +75,7 @@ static void check(int path, const tape *t, const interval box[][3], unsigned n, 
                      box[l][1].lo, box[l][1].hi, box[l][2].lo, box[l][2].hi, out[l].lo,
                      out[l].hi, fl[l], r.lo, r.hi, f1);
     }
+    check_grad(path, t, box, n, what);
 }
 
 /* An end from the edge cases, or an ordinary number. */

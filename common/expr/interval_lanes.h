@@ -1,11 +1,11 @@
-/* interval_lanes: the fast path of interval_add and interval_mul in a form
- * that vectorises: bit-pattern tests (no floating-point exception, no
- * branch) of when that path applies, and its bit steps. Where il_normal
- * holds for a sum's ends, interval_add's result is [il_step_down(lo),
- * il_step_up(hi)]; where the four ends of two factors are finite and the
- * least and greatest of the four products are normal, interval_mul's is the
- * same of those. Used by the lane interval evaluator (tape_ilanes.c) and the
- * rasterizer's mean-value forms. */
+/* interval_lanes: the fast paths of interval_add, interval_mul and
+ * interval_sqr in a form that vectorises: bit-pattern tests (no
+ * floating-point exception, no branch) of when that path applies, and its
+ * bit steps. Where il_normal holds for a sum's ends, interval_add's result
+ * is [il_step_down(lo), il_step_up(hi)]; where the four ends of two factors
+ * are finite and the least and greatest of the four products are normal,
+ * interval_mul's is the same of those. Used by the lane interval evaluators
+ * (tape_ilanes.c, tape_iglanes.c) and the rasterizer's mean-value forms. */
 #ifndef INTERVAL_LANES_H
 #define INTERVAL_LANES_H
 
@@ -68,16 +68,42 @@ static inline uint64_t il_zero(double x) { return (il_bits(x) << 1) == 0; }
 /* interval_mul(a, b) likewise; with finite ends, a factor that is exactly
  * [0, 0] gives interval_mul's [+0, +0] (a zero end from a zero factor stays
  * 0: the partials of a term without that variable). */
-static inline interval il_mul(interval a, interval b, uint64_t *ok)
+/* interval_sqr([al, ah]) where its fast path applies (finite ends, normal
+ * results but a lower 0 of a straddling a); *ok becomes 0 where not. */
+INTERVAL_INLINE void il_sqr_ends(double al, double ah, double *rlo, double *rhi, uint64_t *ok)
 {
-    uint64_t f = il_finite(a.lo) & il_finite(a.hi) & il_finite(b.lo) & il_finite(b.hi);
-    uint64_t z = (il_zero(a.lo) & il_zero(a.hi)) | (il_zero(b.lo) & il_zero(b.hi));
-    double al = il_sel(f, a.lo, 1.0), ah = il_sel(f, a.hi, 1.0);
-    double bl = il_sel(f, b.lo, 1.0), bh = il_sel(f, b.hi, 1.0);
+    uint64_t f = il_finite(al) & il_finite(ah);
+    double x = il_sel(f, al, 1.0), y = il_sel(f, ah, 1.0);
+    double m1 = x * x, m2 = y * y;
+    uint64_t strad = (uint64_t)(x < 0.0) & (uint64_t)(y > 0.0);
+    double h = il_max(m1, m2), l0 = il_min(m1, m2);
+    *ok &= f & il_normal(h) & (strad | il_normal(l0));
+    *rlo = il_sel(strad, 0.0, il_step_down(l0));
+    *rhi = il_step_up(h);
+}
+
+/* il_mul on the ends (the lane loops' form): [*rlo, *rhi] = [al, ah] x
+ * [bl, bh] where *ok stays 1. */
+INTERVAL_INLINE void il_mul_ends(double al, double ah, double bl, double bh, double *rlo,
+                                 double *rhi, uint64_t *ok)
+{
+    uint64_t f = il_finite(al) & il_finite(ah) & il_finite(bl) & il_finite(bh);
+    uint64_t z = (il_zero(al) & il_zero(ah)) | (il_zero(bl) & il_zero(bh));
+    al = il_sel(f, al, 1.0);
+    ah = il_sel(f, ah, 1.0);
+    bl = il_sel(f, bl, 1.0);
+    bh = il_sel(f, bh, 1.0);
     double p1 = al * bl, p2 = al * bh, p3 = ah * bl, p4 = ah * bh;
     double lo = il_min(il_min(p1, p2), il_min(p3, p4)), hi = il_max(il_max(p1, p2), il_max(p3, p4));
     *ok &= f & (z | (il_normal(lo) & il_normal(hi)));
-    interval r = {il_sel(z, 0.0, il_step_down(lo)), il_sel(z, 0.0, il_step_up(hi))};
+    *rlo = il_sel(z, 0.0, il_step_down(lo));
+    *rhi = il_sel(z, 0.0, il_step_up(hi));
+}
+
+INTERVAL_INLINE interval il_mul(interval a, interval b, uint64_t *ok)
+{
+    interval r;
+    il_mul_ends(a.lo, a.hi, b.lo, b.hi, &r.lo, &r.hi, ok);
     return r;
 }
 

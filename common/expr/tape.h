@@ -172,6 +172,22 @@ void tape_eval_interval_lanes_on(int path, const tape *t, unsigned n,
 interval tape_eval_interval_grad(const tape *t, const interval box[3], interval grad[3],
                                  tape_idual *slots, unsigned *flags);
 
+/* tape_eval_interval_grad on up to TAPE_LANES boxes at once: out[l],
+ * grad[l] and flags[l] are, bit for bit, its results on box[l] for l < n
+ * (1 <= n <= TAPE_LANES). `slots` is the caller's scratch of t->n elements
+ * (common/expr/tape_iglanes.c); _on runs a given build, as
+ * tape_eval_interval_lanes_on. */
+typedef struct tape_idual_lanes {
+    tape_ilanes v, d[3];
+} tape_idual_lanes;
+void tape_eval_interval_grad_lanes(const tape *t, unsigned n, const interval box[][3],
+                                   interval out[], interval grad[][3], unsigned flags[],
+                                   tape_idual_lanes *slots);
+void tape_eval_interval_grad_lanes_on(int path, const tape *t, unsigned n,
+                                      const interval box[][3], interval out[],
+                                      interval grad[][3], unsigned flags[],
+                                      tape_idual_lanes *slots);
+
 /* ---- Pruning ----------------------------------------------------------- */
 
 /* Shortens t for the box whose slot enclosures `slots` (from

@@ -77,16 +77,10 @@ static void SQR_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, unsig
 {
     uint64_t ok = ~(uint64_t)0, bad[W];
     LANES {
-        uint64_t f = il_finite(a->lo[l]) & il_finite(a->hi[l]);
-        double x = il_sel(f, a->lo[l], 1.0), y = il_sel(f, a->hi[l], 1.0);
-        double m1 = x * x, m2 = y * y;
-        uint64_t strad = (uint64_t)(x < 0.0) & (uint64_t)(y > 0.0);
-        double h = il_max(m1, m2), l0 = il_min(m1, m2);
-        uint64_t g = f & il_normal(h) & (strad | il_normal(l0));
+        uint64_t g = 1;
+        il_sqr_ends(a->lo[l], a->hi[l], &r->lo[l], &r->hi[l], &g);
         bad[l] = g ^ 1;
         ok &= g;
-        r->lo[l] = il_sel(strad, 0.0, il_step_down(l0));
-        r->hi[l] = il_step_up(h);
     }
     if (ok)
         return;

@@ -10,4 +10,4 @@
 #include "common/expr/tape_ilanes_body.h"
 #undef W
 #undef FN
-TAPE_ILANES_DEFINE(NAME)
+TAPE_ILANES_DEFINE(NAME, tape_ilanes)

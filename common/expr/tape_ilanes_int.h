@@ -32,6 +32,18 @@ static inline void il_set(tape_ilanes *v, unsigned l, interval x)
     v->hi[l] = x.hi;
 }
 
+static inline tape_idual igl_get(const tape_idual_lanes *v, unsigned l)
+{
+    tape_idual r = {il_get(&v->v, l), {il_get(&v->d[0], l), il_get(&v->d[1], l), il_get(&v->d[2], l)}};
+    return r;
+}
+static inline void igl_set(tape_idual_lanes *v, unsigned l, const tape_idual *x)
+{
+    il_set(&v->v, l, x->v);
+    for (int j = 0; j < 3; j++)
+        il_set(&v->d[j], l, x->d[j]);
+}
+
 /* One build's evaluator: tape_eval_interval_lanes with the boxes already in
  * lanes (lanes n.. repeating lane 0) and fl[] cleared. */
 void tape_ilanes_portable(const tape *t, unsigned n, const tape_ilanes box[3],
@@ -61,10 +73,20 @@ void tape_grad_lanes_avx2_value(const tape *t, unsigned n, const double x[TAPE_L
                                 double f[TAPE_LANES], tape_dual_lanes *s);
 #endif
 
-/* The definitions of one build (NAME its entry), from tape_ilanes_body.h. */
-#define TAPE_ILANES_DEFINE(NAME)                                                              \
+/* The lane interval gradient evaluator's builds (tape_iglanes.c,
+ * tape_iglanes_avx2.c), with the boxes in lanes as above. */
+void tape_iglanes_portable(const tape *t, unsigned n, const tape_ilanes box[3],
+                           unsigned fl[TAPE_LANES], tape_idual_lanes *slots);
+#if TAPE_ILANES_AVX2
+void tape_iglanes_avx2(const tape *t, unsigned n, const tape_ilanes box[3],
+                       unsigned fl[TAPE_LANES], tape_idual_lanes *slots);
+#endif
+
+/* The definitions of one build (NAME its entry), from tape_ilanes_body.h
+ * or tape_iglanes_body.h (SLOT the slot type). */
+#define TAPE_ILANES_DEFINE(NAME, SLOT)                                                        \
     void NAME(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[TAPE_LANES],    \
-              tape_ilanes *slots)                                                             \
+              SLOT *slots)                                                                    \
     {                                                                                         \
         if (n <= 4)                                                                           \
             CAT(NAME, _4)(t, n, box, fl, slots);                                              \

@@ -1,0 +1,13 @@
+/* tape_iglanes_inst.h: the lane interval gradient evaluator for 4 and 8
+ * lanes and its entry NAME, included by one build's file with NAME defined. */
+#define W 4
+#define FN CAT(NAME, _4)
+#include "common/expr/tape_iglanes_body.h"
+#undef W
+#undef FN
+#define W 8
+#define FN CAT(NAME, _8)
+#include "common/expr/tape_iglanes_body.h"
+#undef W
+#undef FN
+TAPE_ILANES_DEFINE(NAME, tape_idual_lanes)
