@@ -349,6 +349,14 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
     }
     if (any)
         newton_rounds(wk, c->full[0], w, box, live, n, h);
-    for (unsigned j = 0; j < n && !wk->failed; j++)
-        push_voxel(wk, newton_record(wk, &nw[j], centre[j], h), 0);
+    uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
+    for (unsigned j = 0; j < n; j++)
+        rec[j] = newton_record(wk, &nw[j], centre[j], h);
+    if (wk->failed || !n)
+        return;
+    if (buf_push(&wk->out->voxels, rec, n * sizeof *rec)) {
+        wk->failed = 1;
+        return;
+    }
+    wk->st.voxels += n;
 }
