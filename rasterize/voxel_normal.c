@@ -169,8 +169,8 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
  * the axes that have such a pair (bit k for column k). */
 static unsigned leaf_columns(const double *fg, unsigned have, const child_boxes *cb, double D[3][3])
 {
-    /* the lower child of each pair along axis k, in increasing order */
-    static const uint8_t lower[3][4] = {{0, 2, 4, 6}, {0, 1, 4, 5}, {0, 1, 2, 3}};
+    /* the children whose bit k is 0: the lower ones of the pairs along axis k */
+    static const uint8_t lower[3] = {0x55, 0x33, 0x0f};
     unsigned axes = 0;
     for (unsigned k = 0; k < 3; k++) {
         const unsigned bk = 1u << k;
@@ -178,10 +178,9 @@ static unsigned leaf_columns(const double *fg, unsigned have, const child_boxes 
         const double dx = cb->mid[k][1] - cb->mid[k][0];
         double d[3] = {0.0, 0.0, 0.0};
         unsigned pairs = 0;
-        for (unsigned q = 0; q < 4; q++) {
-            const unsigned lo = lower[k][q], hi = lo | bk;
-            if (!((have >> lo) & (have >> hi) & 1u))
-                continue;
+        /* the pairs present, lower child first, in increasing order */
+        for (unsigned m = have & (have >> bk) & lower[k]; m; m &= m - 1) {
+            const unsigned lo = (unsigned)__builtin_ctz(m), hi = lo | bk;
             const double *ga = fg + 4 * lo + 1, *gb = fg + 4 * hi + 1;
             d[0] += (gb[0] - ga[0]) / dx;
             d[1] += (gb[1] - ga[1]) / dx;
