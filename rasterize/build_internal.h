@@ -280,8 +280,11 @@ typedef struct leaf_voxels {
 
 /* The records of the voxels of nb leaf-parents of a single-surface scene,
  * appended leaf-parent by leaf-parent, each in child order: what
- * emit_voxels makes of each, with the Newton evaluations of all of them
- * pooled into passes of TAPE_LANES points. At most 8 leaf-parents. */
+ * emit_voxels makes of each, except that a leaf-parent whose children give
+ * no second differences along some axis takes the entries of its Hessian
+ * it cannot make from the nearest of them that has a whole one; the Newton
+ * evaluations of the rest pooled into passes of TAPE_LANES points. At most
+ * 8 leaf-parents. */
 void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb);
 
 /* --- the recursion (subdivide.c) ---------------------------------------- */

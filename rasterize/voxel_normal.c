@@ -1,8 +1,9 @@
 /* voxel_normal: a voxel's record. The surface it belongs to, guarded Newton
  * steps from its centre onto f = 0 (at a leaf-parent, where its siblings'
  * gradients give second derivatives, one step on the second-order model
- * instead), and the normal and plane offset packed from where they stop
- * (format/oct_normal.h). */
+ * instead; in a batch, a leaf-parent lacking some takes them from its
+ * nearest sibling that has them all), and the normal and plane offset
+ * packed from where they stop (format/oct_normal.h). */
 #include <math.h>
 
 #include "format/oct_normal.h"
@@ -161,26 +162,25 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
     return push_voxel(wk, newton_record(wk, &nw, centre, h), best);
 }
 
-/* A finite-difference Hessian over a leaf-parent, shared by its voxels,
- * from the gradients at its children's centres (fg: f and grad f of child
- * i at fg[4 i], for the children set in have): column k the mean of the
- * differences over the pairs of children that differ in bit k alone, then
- * symmetrised. 0 when an axis has no such pair or a value is not finite. */
-static int leaf_hessian(const double *fg, unsigned have, const child_boxes *cb, double H[3][3])
+/* The finite-difference columns of a leaf-parent's Hessian, from the
+ * gradients at its children's centres (fg: f and grad f of child i at
+ * fg[4 i], for the children set in have): column k of D the mean of the
+ * differences over the pairs of children that differ in bit k alone. Returns
+ * the axes that have such a pair (bit k for column k). */
+static unsigned leaf_columns(const double *fg, unsigned have, const child_boxes *cb, double D[3][3])
 {
-    /* the lower child of each pair along axis k, in increasing order */
-    static const uint8_t lower[3][4] = {{0, 2, 4, 6}, {0, 1, 4, 5}, {0, 1, 2, 3}};
-    double D[3][3];
+    /* the children whose bit k is 0: the lower ones of the pairs along axis k */
+    static const uint8_t lower[3] = {0x55, 0x33, 0x0f};
+    unsigned axes = 0;
     for (unsigned k = 0; k < 3; k++) {
         const unsigned bk = 1u << k;
         /* every pair's centres differ along k by the two halves' middles */
         const double dx = cb->mid[k][1] - cb->mid[k][0];
         double d[3] = {0.0, 0.0, 0.0};
         unsigned pairs = 0;
-        for (unsigned q = 0; q < 4; q++) {
-            const unsigned lo = lower[k][q], hi = lo | bk;
-            if (!((have >> lo) & (have >> hi) & 1u))
-                continue;
+        /* the pairs present, lower child first, in increasing order */
+        for (unsigned m = have & (have >> bk) & lower[k]; m; m &= m - 1) {
+            const unsigned lo = (unsigned)__builtin_ctz(m), hi = lo | bk;
             const double *ga = fg + 4 * lo + 1, *gb = fg + 4 * hi + 1;
             d[0] += (gb[0] - ga[0]) / dx;
             d[1] += (gb[1] - ga[1]) / dx;
@@ -188,13 +188,41 @@ static int leaf_hessian(const double *fg, unsigned have, const child_boxes *cb, 
             pairs++;
         }
         if (!pairs)
-            return 0;
+            continue;
         for (unsigned r = 0; r < 3; r++)
             D[r][k] = d[r] / (double)pairs;
+        axes |= bk;
+    }
+    return axes;
+}
+
+/* A leaf-parent's Hessian from its columns D (axes: leaf_columns's),
+ * symmetrised; entries with neither axis among the columns taken from a
+ * sibling's Hessian B (NULL: none). 0 when some entry has no value. */
+static int leaf_hessian(const double D[3][3], unsigned axes, const double (*B)[3], double H[3][3])
+{
+    if (axes == 7) {
+        for (unsigned r = 0; r < 3; r++)
+            for (unsigned k = 0; k < 3; k++) {
+                H[r][k] = 0.5 * (D[r][k] + D[k][r]);
+                if (!isfinite(H[r][k]))
+                    return 0;
+            }
+        return 1;
     }
     for (unsigned r = 0; r < 3; r++)
         for (unsigned k = 0; k < 3; k++) {
-            H[r][k] = 0.5 * (D[r][k] + D[k][r]);
+            const unsigned ar = (axes >> r) & 1, ak = (axes >> k) & 1;
+            if (ar && ak)
+                H[r][k] = 0.5 * (D[r][k] + D[k][r]);
+            else if (ak) /* d(grad_r)/dk from this leaf-parent's own column k */
+                H[r][k] = D[r][k];
+            else if (ar)
+                H[r][k] = D[k][r];
+            else if (B)
+                H[r][k] = B[r][k];
+            else
+                return 0;
             if (!isfinite(H[r][k]))
                 return 0;
         }
@@ -294,7 +322,9 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
     for (unsigned j = 0; j < np; j++) {
         if ((int)surf[j] != hs) {
             hs = surf[j];
-            have_h = leaf_hessian(wk->cf8 + (size_t)surf[j] * 32, wk->cf8_have[surf[j]], cb, H);
+            double D[3][3];
+            have_h = leaf_columns(wk->cf8 + (size_t)surf[j] * 32, wk->cf8_have[surf[j]], cb, D) == 7 &&
+                     leaf_hessian(D, 7, NULL, H);
         }
         live[j] = (uint8_t)newton_first(&nw[j], cb->box[child[j]], cb->centre[child[j]], h,
                                         have_h ? (const double (*)[3])H : NULL);
@@ -320,6 +350,17 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
         push_voxel(wk, newton_record(wk, &nw[j], cb->centre[child[j]], h), surf[j]);
 }
 
+/* Squared distance between the centres of two leaf-parents. */
+static double leaf_dist2(const child_boxes *a, const child_boxes *b)
+{
+    double d2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double d = (a->mid[k][0] + a->mid[k][1]) - (b->mid[k][0] + b->mid[k][1]);
+        d2 += d * d;
+    }
+    return d2;
+}
+
 void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
 {
     const build_ctx *c = wk->c;
@@ -329,12 +370,35 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
     const double *centre[ROUND_MAX];
     uint8_t live[ROUND_MAX];
     unsigned n = 0, any = 0;
+    double D[8][3][3], H[8][3][3];
+    unsigned axes[8];
+    int have_h[8]; /* leaf-parent b's Hessian in H[b]: its own (1), completed from a sibling's (2) */
     for (unsigned b = 0; b < nb; b++) {
-        double H[3][3];
+        axes[b] = lv[b].keep ? leaf_columns(lv[b].cf8, lv[b].have, lv[b].cb, D[b]) : 0;
+        have_h[b] = axes[b] == 7 && leaf_hessian(D[b], 7, NULL, H[b]);
+    }
+    /* A leaf-parent without a pair along some axis has no differences along
+     * it: the entries of H with neither index among its own axes (the other
+     * rows and columns of H come from its own columns, H being symmetric)
+     * are those of the nearest sibling with a whole Hessian. */
+    for (unsigned b = 0; b < nb; b++) {
+        if (!lv[b].keep || have_h[b])
+            continue;
+        int from = -1;
+        double best = INFINITY;
+        for (unsigned a = 0; a < nb; a++)
+            if (have_h[a] == 1 && leaf_dist2(lv[a].cb, lv[b].cb) < best) {
+                best = leaf_dist2(lv[a].cb, lv[b].cb);
+                from = (int)a;
+            }
+        if (from >= 0)
+            have_h[b] = 2 * leaf_hessian(D[b], axes[b], (const double (*)[3])H[from], H[b]);
+    }
+    for (unsigned b = 0; b < nb; b++) {
         const leaf_voxels *v = &lv[b];
         if (!v->keep)
             continue;
-        int have_h = leaf_hessian(v->cf8, v->have, v->cb, H);
+        const double (*Hb)[3] = have_h[b] ? (const double (*)[3])H[b] : NULL;
         for (unsigned i = 0; i < 8; i++) {
             if (!((v->keep >> i) & 1))
                 continue;
@@ -342,13 +406,20 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
             w[n] = &nw[n];
             box[n] = v->cb->box[i];
             centre[n] = v->cb->centre[i];
-            live[n] = (uint8_t)newton_first(&nw[n], box[n], centre[n], h,
-                                            have_h ? (const double (*)[3])H : NULL);
+            live[n] = (uint8_t)newton_first(&nw[n], box[n], centre[n], h, Hb);
             any |= live[n++];
         }
     }
     if (any)
         newton_rounds(wk, c->full[0], w, box, live, n, h);
-    for (unsigned j = 0; j < n && !wk->failed; j++)
-        push_voxel(wk, newton_record(wk, &nw[j], centre[j], h), 0);
+    uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
+    for (unsigned j = 0; j < n; j++)
+        rec[j] = newton_record(wk, &nw[j], centre[j], h);
+    if (wk->failed || !n)
+        return;
+    if (buf_push(&wk->out->voxels, rec, n * sizeof *rec)) {
+        wk->failed = 1;
+        return;
+    }
+    wk->st.voxels += n;
 }

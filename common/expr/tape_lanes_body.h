@@ -24,6 +24,21 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
 {
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
+    double pt[3][W]; /* the points, lanes from n on repeating lane 0, made once a pass */
+    LANES {
+        pt[0][l] = x[l < n ? l : 0];
+        pt[1][l] = y[l < n ? l : 0];
+        pt[2][l] = z[l < n ? l : 0];
+    }
+/* A variable: its coordinate, and the unit vector along its axis (AX, a
+ * constant in each case, so the stores are of constants). */
+#define AXIS(AX)                                                                                   \
+    LANES {                                                                                        \
+        r->v[l] = pt[AX][l];                                                                       \
+        r->d[0][l] = (AX) == 0 ? 1.0 : 0.0;                                                        \
+        r->d[1][l] = (AX) == 1 ? 1.0 : 0.0;                                                        \
+        r->d[2][l] = (AX) == 2 ? 1.0 : 0.0;                                                        \
+    }
     for (uint32_t i = 0, len = t->n; i < len; i++) {
         tape_dual_lanes *restrict r = &s[i];
         uint32_t op = in[i].op;
@@ -37,17 +52,9 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             }
             break;
         }
-        case TAPE_X: case TAPE_Y: case TAPE_Z: {
-            int ax = (int)op - TAPE_X;
-            const double *p = ax == 0 ? x : ax == 1 ? y : z;
-            LANES {
-                r->v[l] = p[l < n ? l : 0];
-                r->d[0][l] = ax == 0 ? 1.0 : 0.0;
-                r->d[1][l] = ax == 1 ? 1.0 : 0.0;
-                r->d[2][l] = ax == 2 ? 1.0 : 0.0;
-            }
-            break;
-        }
+        case TAPE_X: AXIS(0); break;
+        case TAPE_Y: AXIS(1); break;
+        case TAPE_Z: AXIS(2); break;
         case TAPE_NEG:
             LANES { r->v[l] = -A->v[l]; m[l] = -1.0; }
             SCALE(r, A, m);
@@ -168,6 +175,7 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
     memcpy(g, r->d, sizeof r->d);
 }
 
+#undef AXIS
 #undef LANES
 #undef A
 #undef C
