@@ -4,6 +4,7 @@
 #include <math.h>
 #include <pthread.h>
 
+#include "render/basis.h"
 #include "render/shadow.h"
 
 /* cos and sin of 2 pi frac(k phi), k < AO_MAX_RAYS: the pattern's azimuths,
@@ -41,15 +42,7 @@ void ao_basis(const float n[3], uint32_t seed, ao_frame *f)
     const double len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
     for (int a = 0; a < 3; a++)
         nn[a] /= len;
-    /* an orthonormal basis t, b, nn (Duff et al. 2017, branchless) */
-    const double sg = nn[2] >= 0.0 ? 1.0 : -1.0;
-    const double ka = -1.0 / (sg + nn[2]), kb = nn[0] * nn[1] * ka;
-    f->t[0] = 1.0 + sg * nn[0] * nn[0] * ka;
-    f->t[1] = sg * kb;
-    f->t[2] = -sg * nn[0];
-    f->b[0] = kb;
-    f->b[1] = sg + nn[1] * nn[1] * ka;
-    f->b[2] = -nn[1];
+    basis_across(nn, f->t, f->b);
 }
 
 void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, double d[3])

@@ -128,8 +128,8 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
             goto lit; /* no start off the surface: lit and open */
         if (shadow) {
             acc->shadow_rays++;
-            if (shadow_blocked_from(job->tree, &job->opts, sh->traverse, st, job->shade.light,
-                                    INFINITY, &acc->secondary_steps))
+            if (shadow_blocked_from(job->tree, &job->opts, sh->traverse, st, sh->shadow_map,
+                                    job->shade.light, INFINITY, &acc->secondary_steps))
                 lam = 0.0;
             if (job->timing)
                 t1 = frame_now_ns();
@@ -476,6 +476,16 @@ int frame_render(const frame_job *job, frame_stats *stats)
     pthread_mutex_init(&sy.lock, NULL);
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     int rc = 0;
+    shadow_map smap;
+    if (job->shade.shadows) {
+        /* made on this thread before the passes: its time is the shadow
+           rays', as if every thread waited for it */
+        const double t0 = job->timing ? frame_now_ns() : 0.0;
+        if (shadow_map_build(job->tree, job->shade.light, &smap) == 0)
+            sh.shadow_map = &smap;
+        if (job->timing)
+            sy.sum.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
+    }
     if (job->aa > 1) {
         sh.probes = frame_probes_alloc(npx);
         sh.tile_any = calloc((size_t)sh.tiles_x * sh.tiles_y, 1);
@@ -495,6 +505,8 @@ int frame_render(const frame_job *job, frame_stats *stats)
     }
     frame_probes_free(sh.probes, npx);
     free(sh.tile_any);
+    if (job->shade.shadows)
+        shadow_map_free(&smap);
     exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;

@@ -28,6 +28,7 @@ typedef struct frame_shared {
     aa_probe *probes; /* centre rays, for the antialiasing pass; NULL without */
     uint8_t *tile_any; /* with probes: per tile, 1 when a centre ray hit or a
                           sub-block was marked (supersample_tile) */
+    const shadow_map *shadow_map; /* with --shadows: the light's map, or NULL */
     int phase;        /* 0: centre rays; 1: samples where needed */
     uint32_t tiles_x, tiles_y;
     frame_sync *sync;

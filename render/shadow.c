@@ -137,10 +137,18 @@ int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_
 }
 
 int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
-                        shadow_start *s, const double d[3], double t_max, uint64_t *steps)
+                        shadow_start *s, const shadow_map *map, const double d[3], double t_max,
+                        uint64_t *steps)
 {
     if (!s->eye.ok)
         return 0; /* as trace_setup: no ray */
+    if (map) {
+        const double t_clear = shadow_map_clear_t(map, s->eye.o, d, s->eye.scale);
+        if (t_clear <= 0.0)
+            return 0; /* past every occupied cell from its start */
+        if (t_clear < t_max)
+            t_max = t_clear;
+    }
     /* +0 and -0 make the same set-up, NaN never matches: == is enough */
     trace_dir *td = &s->dir;
     if (!s->dir_ok || td->dir[0] != d[0] || td->dir[1] != d[1] || td->dir[2] != d[2] ||

@@ -28,6 +28,7 @@
 #include <stdint.h>
 
 #include "format/oct.h"
+#include "render/shadow_map.h"
 #include "render/trace.h"
 #include "render/trace_impl.h"
 
@@ -93,8 +94,10 @@ int shadow_blocked(const oct_tree *tree, const trace_opts *opts, trace_traverse_
 
 /* shadow_blocked from s->o, started at s's anchor: the same answer and
  * steps. The set-up's direction part is kept in s for the next call with
- * the same d. */
+ * the same d. With map (made for d; NULL: none) the ray stops where the map
+ * says it is past every occupied cell: the same answer in fewer steps. */
 int shadow_blocked_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
-                        shadow_start *s, const double d[3], double t_max, uint64_t *steps);
+                        shadow_start *s, const shadow_map *map, const double d[3], double t_max,
+                        uint64_t *steps);
 
 #endif

@@ -222,7 +222,7 @@ static void test_shared_start_same_answers(void **state)
                         s0 = s1 = 0;
                         const int b0 = shadow_blocked(t, &o, fn, org, lights[l], INFINITY, &s0);
                         const int b1 =
-                            shadow_blocked_from(t, &o, fn, &st, lights[l], INFINITY, &s1);
+                            shadow_blocked_from(t, &o, fn, &st, NULL, lights[l], INFINITY, &s1);
                         assert_int_equal(b0, b1);
                         assert_true(s0 == s1);
                         blocked += (unsigned)b0;

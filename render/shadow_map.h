@@ -1,0 +1,42 @@
+/* shadow_map: where a shadow ray towards a directional light is past every
+ * occupied cell (RENDER.md, "Shadows"). A ray parallel to the light projects
+ * to one point of the plane across it; the map holds, per square of that
+ * plane (a texel), the greatest height along the light of any occupied cell
+ * of depth levels - SHADOW_MAP_UP whose projection meets the texel (each
+ * cell's box of projected corners and its top grown by SHADOW_MAP_MARGIN).
+ * A ray whose height has passed its texel's value meets no occupied voxel
+ * after that: its shadow test can stop there with the same answer. */
+#ifndef SHADOW_MAP_H
+#define SHADOW_MAP_H
+
+#include <stdint.h>
+
+#include "format/oct.h"
+
+#define SHADOW_MAP_UP 2          /* cells of 2^2 voxels a side, texels as wide */
+#define SHADOW_MAP_MARGIN 0x1p-6 /* grid units: far above the roundings of the
+                                    projections, the heights and the traversal's
+                                    plane times (each under 2^-26 of a voxel) */
+
+typedef struct shadow_map {
+    double light[3];        /* the direction it was made for, as given */
+    double u[3], v[3], w[3]; /* the plane's axes and the unit light, orthonormal */
+    double u0, v0;          /* the plane's origin: the cube's projections start there */
+    double inv_texel;       /* 1 / texel side, grid units */
+    uint32_t nu, nv;
+    double *top;            /* nu * nv greatest heights, -inf: none */
+} shadow_map;
+
+/* Makes m for tree and the unit-or-not light direction `light` (finite,
+ * non-zero). Returns 0, or -1 when the memory cannot be had (m->top NULL:
+ * then shadow_map_clear_t gives +inf). Free with shadow_map_free. */
+int shadow_map_build(const oct_tree *tree, const double light[3], shadow_map *m);
+void shadow_map_free(shadow_map *m); /* accepts a failed build */
+
+/* For the ray g + t (scale * light), g a grid point and scale the tree's
+ * N / edge: a t after which the ray meets no occupied voxel (-inf when it
+ * meets none at all, +inf when the map cannot tell: light not m's, no map). */
+double shadow_map_clear_t(const shadow_map *m, const double g[3], const double light[3],
+                          double scale);
+
+#endif

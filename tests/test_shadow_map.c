@@ -1,0 +1,183 @@
+/* Tests for render/shadow_map: the time after which a ray towards the light
+ * meets no occupied voxel (checked against every voxel's closed box), and
+ * shadow rays stopped there giving the answers of rays traced whole, on
+ * every implementation, with and without --refine. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "bench/rng.h"
+#include "bench/tree_util.h"
+#include "format/oct_normal.h"
+#include "render/shadow.h"
+#include "render/shadow_map.h"
+#include "tests/voxel_shapes.h"
+
+/* The t range in which the ray g + t D meets the closed box [v, v + 1]^3,
+ * t >= 0; 0 when it does not. */
+static int box_span(const double g[3], const double D[3], const uint32_t v[3], double *t0,
+                    double *t1)
+{
+    double lo = 0.0, hi = INFINITY;
+    for (int a = 0; a < 3; a++) {
+        const double b0 = v[a], b1 = v[a] + 1.0;
+        if (D[a] == 0.0) {
+            if (g[a] < b0 || g[a] > b1)
+                return 0;
+            continue;
+        }
+        double ta = (b0 - g[a]) / D[a], tb = (b1 - g[a]) / D[a];
+        if (ta > tb) {
+            const double x = ta;
+            ta = tb;
+            tb = x;
+        }
+        lo = fmax(lo, ta);
+        hi = fmin(hi, tb);
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return lo <= hi;
+}
+
+/* Every voxel a ray meets, even at one point, is met before the map's
+ * time: random trees of 5 and 6 levels (scattered and clustered voxels),
+ * lights with and without zero components, starts inside and outside. */
+static void test_clear_t_bounds_every_voxel(void **state)
+{
+    (void)state;
+    static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0, 0, 1},
+                                       {1, -1, 0},        {-0.1, -0.7, -0.2}, {0, -1, 0}};
+    uint64_t rng = 0x5eed5eedu;
+    unsigned long met = 0, finite = 0, none = 0;
+    for (unsigned levels = 5; levels <= 6; levels++)
+        for (unsigned form = 0; form < 2; form++) {
+            const uint32_t n = UINT32_C(1) << levels;
+            static uint32_t xyz[600][3];
+            const size_t nv = form ? tree_util_distinct_voxels(600, n / 4, n / 3, &rng, xyz)
+                                   : tree_util_distinct_voxels(150, 0, n, &rng, xyz);
+            oct_tree *t = tree_util_simple(levels, (const uint32_t(*)[3])xyz, nv);
+            assert_non_null(t);
+            const double scale = (double)n / t->edge;
+            for (size_t l = 0; l < sizeof lights / sizeof lights[0]; l++) {
+                shadow_map m;
+                assert_int_equal(shadow_map_build(t, lights[l], &m), 0);
+                const double D[3] = {scale * lights[l][0], scale * lights[l][1],
+                                     scale * lights[l][2]};
+                for (int k = 0; k < 400; k++) {
+                    double g[3];
+                    for (int a = 0; a < 3; a++)
+                        g[a] = -2.0 + (n + 4.0) * rng_unit(rng_xorshift64star(&rng));
+                    if (k % 2) {
+                        /* back along the light from near a voxel: a ray past it */
+                        const uint32_t *v = xyz[rng_xorshift64star(&rng) % nv];
+                        const double back = (double)n * rng_unit(rng_xorshift64star(&rng));
+                        for (int a = 0; a < 3; a++)
+                            g[a] = v[a] - 0.5 + 2.0 * rng_unit(rng_xorshift64star(&rng)) -
+                                   back * lights[l][a];
+                    }
+                    if (k % 4 < 2) /* on voxel planes */
+                        for (int a = 0; a < 3; a++)
+                            g[a] = floor(g[a]);
+                    const double tc = shadow_map_clear_t(&m, g, lights[l], scale);
+                    assert_true(tc < INFINITY);
+                    int any = 0;
+                    for (size_t i = 0; i < nv; i++) {
+                        double t0, t1;
+                        if (box_span(g, D, xyz[i], &t0, &t1)) {
+                            assert_true(t0 < tc);
+                            any = 1;
+                        }
+                    }
+                    met += (unsigned)any;
+                    none += tc == -INFINITY;
+                    finite += tc > -INFINITY;
+                }
+                assert_true(shadow_map_clear_t(&m, (const double[3]){1, 1, 1}, lights[(l + 1) % 6],
+                                               scale) == INFINITY); /* not its light */
+                shadow_map_free(&m);
+            }
+            tree_util_free(t);
+        }
+    print_message("map: %lu rays meeting voxels, %lu with a finite end, %lu clear from the start\n",
+                  met, finite, none);
+    assert_true(met > 2000 && none > 1000);
+}
+
+/* Shadow rays from the hits of a view, stopped where the map says: the
+ * answers of the rays traced whole, never more steps. */
+static void test_stopped_rays_same_answers(void **state)
+{
+    (void)state;
+    enum { LEVELS = 6 };
+    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
+                   shape_sphere(40, 40, 30, 8)};
+    sh[0].lo[0] = 20;
+    sh[1].lo[2] = 20;
+    oct_tree *t = shapes_build(LEVELS, 64.0, sh, 3, 1);
+    assert_non_null(t);
+    const double eye[3] = {150, 110, 120};
+    static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5},
+                                       {0, 0, 1}};
+    enum { NL = sizeof lights / sizeof lights[0] };
+    shadow_map maps[NL];
+    for (unsigned l = 0; l < NL; l++)
+        assert_int_equal(shadow_map_build(t, lights[l], &maps[l]), 0);
+    unsigned long rays = 0, blocked = 0, fewer = 0;
+    for (unsigned impl = 0; impl < trace_impl_count; impl++)
+        for (int refine = 0; refine <= 1; refine++) {
+            const trace_opts o = {.split = LEVELS, .refine = refine};
+            const trace_traverse_fn fn = trace_impls[impl].traverse;
+            shadow_start st;
+            st.near = 0;
+            for (int y = 0; y < 40; y++)
+                for (int x = 0; x < 40; x++) {
+                    const double target[3] = {18.0 + 1.13 * x, 18.0 + 1.07 * y, 21.3};
+                    double dir[3];
+                    for (int a = 0; a < 3; a++)
+                        dir[a] = target[a] - eye[a];
+                    trace_hit h;
+                    if (!trace_ray_cast(t, &o, eye, dir, &h))
+                        continue;
+                    float n[3];
+                    oct_normal_decode(t->voxels[h.voxel] & OCT_VOXEL_NORMAL_MASK, n);
+                    if (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0.0)
+                        for (int a = 0; a < 3; a++)
+                            n[a] = -n[a];
+                    if (!shadow_start_hit(t, &h, n, &st))
+                        continue;
+                    for (unsigned l = 0; l < NL; l++) {
+                        uint64_t s0 = 0, s1 = 0;
+                        const int b0 = shadow_blocked_from(t, &o, fn, &st, NULL, lights[l],
+                                                           INFINITY, &s0);
+                        const int b1 = shadow_blocked_from(t, &o, fn, &st, &maps[l], lights[l],
+                                                           INFINITY, &s1);
+                        assert_int_equal(b0, b1);
+                        assert_true(s1 <= s0);
+                        rays++;
+                        blocked += (unsigned)b0;
+                        fewer += s1 < s0;
+                    }
+                }
+        }
+    for (unsigned l = 0; l < NL; l++)
+        shadow_map_free(&maps[l]);
+    print_message("stopped rays: %lu rays, %lu blocked, %lu in fewer steps\n", rays, blocked,
+                  fewer);
+    assert_true(rays > 4000 && blocked > 200 && fewer > rays / 4);
+    tree_util_free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_clear_t_bounds_every_voxel),
+        cmocka_unit_test(test_stopped_rays_same_answers),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
