@@ -1,7 +1,8 @@
-/* frame_samples: the antialiasing pass of a frame (RENDER.md,
- * "Antialiasing"): the pixels the edge test picks, traced again with
- * samples from their beam sub-block's start: as packets under the paper's
- * rule (trace_packet.h), else one by one from the pixel's anchor. */
+/* frame_samples: the antialiasing of a frame (RENDER.md, "Antialiasing"):
+ * the edge test inside each tile and across tile borders, and the pixels it
+ * picks traced again with samples from their beam sub-block's start: as
+ * packets under the paper's rule (trace_packet.h), else one by one from the
+ * pixel's anchor. */
 #include "render/frame_impl.h"
 
 #include <math.h>
@@ -11,49 +12,46 @@
 #include "render/beam.h"
 #include "render/trace_packet.h"
 
-/* A megapixel's probes are 24 MB, whose first touch in the centre pass
- * took some 6 000 page faults (13 ms of system time at 1024^2,
- * docs/perf-log.md): large ones are mapped asking for huge pages. */
-#define PROBES_MAPPED (UINT64_C(1) << 21)
+/* The border probes of a megapixel are 3 MB, whose first touch costs some
+ * 750 page faults: large ones are mapped asking for huge pages. */
+#define BORDER_MAPPED (UINT64_C(1) << 21)
 
-aa_probe *frame_probes_alloc(size_t n)
+aa_probe *frame_border_alloc(size_t n)
 {
-    const size_t bytes = n * sizeof(aa_probe);
-    if (n > SIZE_MAX / sizeof(aa_probe))
+    if (n > SIZE_MAX / (FRAME_BORDER * sizeof(aa_probe)))
         return NULL;
+    const size_t bytes = n * FRAME_BORDER * sizeof(aa_probe);
 #if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
-    if (bytes >= PROBES_MAPPED) {
+    if (bytes >= BORDER_MAPPED) {
         void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
         if (p == MAP_FAILED)
             return NULL;
         (void)madvise(p, bytes, MADV_HUGEPAGE); /* a hint: no huge pages is fine */
-        return p; /* zeroed */
+        return p;
     }
 #endif
-    return calloc(n, sizeof(aa_probe));
+    return malloc(bytes ? bytes : 1);
 }
 
-void frame_probes_free(aa_probe *p, size_t n)
+void frame_border_free(aa_probe *p, size_t n)
 {
     if (!p)
         return;
 #if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
-    if (n * sizeof(aa_probe) >= PROBES_MAPPED) {
-        munmap(p, n * sizeof(aa_probe));
+    if (n * FRAME_BORDER * sizeof(aa_probe) >= BORDER_MAPPED) {
+        munmap(p, n * FRAME_BORDER * sizeof(aa_probe));
         return;
     }
 #endif
     free(p);
 }
 
-/* Where the samples of pixel (i, j) may start (+inf: they all miss): its
- * sub-block's start, since a sub-block's pyramid holds its pixels' whole
- * squares (beam.h); --beam 0 starts at the eye. */
-static double sample_start(const frame_shared *sh, uint32_t i, uint32_t j)
+/* Where the samples of the pixel of centre probe c may start (+inf: they
+ * all miss): its sub-block's start, since a sub-block's pyramid holds its
+ * pixels' whole squares (beam.h); --beam 0 starts at the eye. */
+static double sample_start(const frame_shared *sh, const aa_probe *c)
 {
-    if (!sh->job->beam_size)
-        return 0.0;
-    return sh->probes[(size_t)j * sh->job->cam->width + i].t_lo;
+    return sh->job->beam_size ? (double)c->t_lo : 0.0;
 }
 
 /* The anchor of pixel (i, j)'s samples, which all start at t_lo: the
@@ -128,14 +126,14 @@ static void trace_samples(const frame_shared *sh, pixel_samples *ps, const unsig
         sh->traverse(job->tree, &job->opts, &r[k], &ps->an, &hits[slot[k]]);
 }
 
-/* Pixel (i, j) again with samples (aa.h): the four corner samples of the
+/* Pixel (i, j), centre probe cp, again with samples (aa.h): the four corner samples of the
  * N x N grid first; when they and the centre ray all agree by the edge
  * rule, the pixel holds no edge and they are its colour; otherwise all
  * N x N. Each is shaded as a pixel is (AO rays k * per .. of per * N^2
  * for sample k), in the order of k within each of the two sets; colours
  * averaged in linear light. */
 static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
-                        uint32_t j)
+                        uint32_t j, const aa_probe *cp)
 {
     const frame_job *job = sh->job;
     const camera *cam = job->cam;
@@ -154,7 +152,7 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     ps.eye = eye;
     ps.i = i;
     ps.j = j;
-    ps.t_lo = sample_start(sh, i, j);
+    ps.t_lo = sample_start(sh, cp);
     ps.packets = !job->exact && !job->opts.refine && !job->no_packets;
     ps.anchor_found = 0;
     float sum[3] = {0.0f, 0.0f, 0.0f};
@@ -178,7 +176,7 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
                 p.hit = (uint8_t)h[q].hit;
                 p.t = h[q].hit ? (float)h[q].t : INFINITY;
                 p.surface = shade_surface(job->tree, &h[q]);
-                uniform &= !aa_differs(&p, &sh->probes[px]);
+                uniform &= !aa_differs(&p, cp);
                 hits += p.hit;
                 if (p.hit || !job->alpha)
                     for (int a = 0; a < 3; a++)
@@ -198,18 +196,76 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     acc->aa_full += done == ns;
 }
 
-/* The antialiasing pass over [i0, i1) x [j0, j1): samples where needed. */
-void frame_supersample_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
-                            uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+/* Sides of a tile's border probes (frame_impl.h). */
+enum { TOP, BOTTOM, LEFT, RIGHT };
+
+static aa_probe *border_of(const frame_shared *sh, uint32_t tx, uint32_t ty)
 {
-    const camera *cam = sh->job->cam;
-    for (uint32_t j = j0; j < j1; j++) {
-        /* a tile without hits or marks: only its border pixels have a
-           neighbour that may differ (in the next tile) */
-        const uint32_t step = any || j == j0 || j + 1 == j1 || i1 - i0 < 2 ? 1 : i1 - i0 - 1;
-        for (uint32_t i = i0; i < i1; i += step)
-            if (aa_needs(sh->probes, cam->width, cam->height, i, j))
-                supersample(sh, acc, eye, i, j);
-    }
+    return sh->border + ((size_t)ty * sh->tiles_x + tx) * FRAME_BORDER;
 }
 
+/* Adds the thread time since t0 to the samples', less the secondary rays'
+ * time since their sum was sec0. */
+static void sample_time(const frame_shared *sh, frame_acc *acc, double t0, double sec0)
+{
+    if (sh->job->timing)
+        acc->sample_ns += frame_now_ns() - t0 - (acc->shadow_ns + acc->ao_ns - sec0);
+}
+
+void frame_aa_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
+                   uint32_t tx, uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+{
+    const double t0 = sh->job->timing ? frame_now_ns() : 0.0, sec0 = acc->shadow_ns + acc->ao_ns;
+    aa_probe *const tp = sh->tile->p;
+    const uint32_t w = i1 - i0, h = j1 - j0;
+    if (any) {
+        aa_mark_inside(tp, FRAME_TILE, w, h);
+        for (uint32_t j = 0; j < h; j++)
+            for (uint32_t i = 0; i < w; i++)
+                if (tp[(size_t)j * FRAME_TILE + i].need)
+                    supersample(sh, acc, eye, i0 + i, j0 + j, &tp[(size_t)j * FRAME_TILE + i]);
+    }
+    aa_probe *b = border_of(sh, tx, ty);
+    for (uint32_t k = 0; k < w; k++) {
+        b[TOP * FRAME_TILE + k] = tp[k];
+        b[BOTTOM * FRAME_TILE + k] = tp[(size_t)(h - 1) * FRAME_TILE + k];
+    }
+    for (uint32_t k = 0; k < h; k++) {
+        b[LEFT * FRAME_TILE + k] = tp[(size_t)k * FRAME_TILE];
+        b[RIGHT * FRAME_TILE + k] = tp[(size_t)k * FRAME_TILE + w - 1];
+    }
+    sample_time(sh, acc, t0, sec0);
+}
+
+void frame_aa_border(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t tx,
+                     uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+{
+    const double t0 = sh->job->timing ? frame_now_ns() : 0.0, sec0 = acc->shadow_ns + acc->ao_ns;
+    const camera *cam = sh->job->cam;
+    const aa_probe *b = border_of(sh, tx, ty);
+    /* the facing sides of the four neighbouring tiles, where there are */
+    const aa_probe *up = ty > 0 ? border_of(sh, tx, ty - 1) + BOTTOM * FRAME_TILE : NULL;
+    const aa_probe *down = j1 < cam->height ? border_of(sh, tx, ty + 1) + TOP * FRAME_TILE : NULL;
+    const aa_probe *left = tx > 0 ? border_of(sh, tx - 1, ty) + RIGHT * FRAME_TILE : NULL;
+    const aa_probe *right = i1 < cam->width ? border_of(sh, tx + 1, ty) + LEFT * FRAME_TILE : NULL;
+    for (uint32_t j = j0; j < j1; j++) {
+        const uint32_t m = j - j0;
+        /* the outer rows whole, of the others the two outer columns */
+        const uint32_t step = j == j0 || j + 1 == j1 || i1 - i0 < 2 ? 1 : i1 - i0 - 1;
+        for (uint32_t i = i0; i < i1; i += step) {
+            const uint32_t k = i - i0;
+            const aa_probe *p = j == j0       ? &b[TOP * FRAME_TILE + k]
+                                : j + 1 == j1 ? &b[BOTTOM * FRAME_TILE + k]
+                                : i == i0     ? &b[LEFT * FRAME_TILE + m]
+                                              : &b[RIGHT * FRAME_TILE + m];
+            if (p->need) /* sampled by the first pass */
+                continue;
+            if ((j == j0 && up && aa_differs(p, &up[k])) ||
+                (j + 1 == j1 && down && aa_differs(p, &down[k])) ||
+                (i == i0 && left && aa_differs(p, &left[m])) ||
+                (i + 1 == i1 && right && aa_differs(p, &right[m])))
+                supersample(sh, acc, eye, i, j, p);
+        }
+    }
+    sample_time(sh, acc, t0, sec0);
+}
