@@ -500,8 +500,14 @@ int frame_render(const frame_job *job, frame_stats *stats)
     int rc = 0;
     if (job->aa > 1) {
         sh.border = frame_border_alloc(ntiles);
-        if (!sh.border)
+        sh.border_hit = malloc(ntiles ? ntiles : 1);
+        if (!sh.border || !sh.border_hit) {
+            frame_border_free(sh.border, ntiles);
+            free(sh.border_hit);
+            sh.border = NULL;
+            sh.border_hit = NULL;
             rc = ENOMEM; /* one ray a pixel */
+        }
     }
     int rc1 = run_pass(&sh, 0);
     if (sh.border && !atomic_load(&sy.changed)) {
@@ -510,6 +516,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
             rc1 = rc2;
     }
     frame_border_free(sh.border, ntiles);
+    free(sh.border_hit);
     exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;

@@ -39,6 +39,7 @@ typedef struct frame_shared {
     trace_traverse_fn traverse;
     frame_tile *tile; /* with --aa: this thread's tile probes; NULL without */
     aa_probe *border; /* with tile: FRAME_BORDER probes a tile, tiles in row order */
+    uint8_t *border_hit; /* with border: per tile, bit s when a probe of side s hit */
     int phase;        /* 0: centre rays, then the samples a tile's own pixels
                          ask for; 1: those the pairs across tiles ask for */
     uint32_t tiles_x, tiles_y;

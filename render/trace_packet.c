@@ -293,7 +293,8 @@ static void packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, t
                 p.flip |= 1u << a;
     _Alignas(16) double lo[LANES], hi[LANES];
     uint32_t live = 0;
-    for (unsigned s = 0; s < LANES; s++) {
+    /* the SSE2 steps read lanes in pairs: the lane past an odd n too */
+    for (unsigned s = 0; s < n + (n & 1u); s++) {
         if (s >= n) { /* no ray: finite values, an empty interval */
             for (unsigned a = 0; a < 3; a++) {
                 p.zo[a][s] = 0.5;
