@@ -25,7 +25,7 @@ typedef struct frame_sync {
     atomic_int changed; /* set when map_guard abandoned a thread's work */
     pthread_mutex_t lock; /* guards the sums below */
     frame_acc sum;
-    double pass_ns[2]; /* thread time of each pass, secondary rays left out */
+    double pass_ns; /* thread time of the passes, secondary rays left out */
     exact_worker *exact; /* with --exact: one per thread of a pass, else NULL */
     atomic_uint next_exact;
 } frame_sync;
@@ -158,11 +158,27 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
         shade_color(job->tree, &job->shade, h, lam, ao, rgb);
 }
 
+/* Pixel (i, j)'s probe in the tile's. */
+static inline aa_probe *tile_probe(frame_tile *tl, uint32_t i, uint32_t j)
+{
+    return &tl->p[(size_t)(j - tl->j0) * FRAME_TILE + (i - tl->i0)];
+}
+
+/* A sub-block start as the probes keep it: rounded down, never late. */
+static float tile_start(double t_lo)
+{
+    float f = (float)t_lo;
+    if ((double)f > t_lo)
+        f = nextafterf(f, -INFINITY);
+    return f;
+}
+
 /* Traces, shades and stores pixel (i, j)'s centre ray; r is its prepared
- * ray, or NULL for a ray known to miss. */
+ * ray, or NULL for a ray known to miss; t_lo its sub-block's start
+ * (tile_start). */
 static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t i, uint32_t j,
                                 const double dir[3], const trace_ray *r, const trace_anchor *an,
-                                double t_lo)
+                                float t_lo)
 {
     const frame_job *job = sh->job;
     trace_hit h;
@@ -189,18 +205,15 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
             job->normals_f[3 * px + (size_t)a] = h.hit ? n[a] : 0.0f;
     if (job->alpha)
         job->alpha[px] = h.hit ? 255 : 0;
-    if (sh->probes) {
-        aa_probe *p = &sh->probes[px];
+    if (sh->tile) {
+        aa_probe *p = tile_probe(sh->tile, i, j);
         p->hit = (uint8_t)h.hit;
-        p->beam_edge = 0;
+        p->need = 0;
         p->t = h.hit ? (float)h.t : INFINITY;
         p->surface = shade_surface(job->tree, &h);
         for (int a = 0; a < 3; a++)
             p->n[a] = n[a];
-        float f = (float)t_lo; /* rounded down: a start never late */
-        if ((double)f > t_lo)
-            f = nextafterf(f, -INFINITY);
-        p->t_lo = f;
+        p->t_lo = t_lo;
     }
     acc->hits += (uint64_t)h.hit;
     acc->steps += h.steps;
@@ -212,10 +225,9 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
 static void mark_beam_edge(const frame_shared *sh, frame_acc *acc, uint32_t i0, uint32_t i1,
                            uint32_t j0, uint32_t j1)
 {
-    const uint32_t w = sh->job->cam->width;
     for (uint32_t j = j0; j < j1; j++)
         for (uint32_t i = i0; i < i1; i++)
-            sh->probes[(size_t)j * w + i].beam_edge = 1;
+            tile_probe(sh->tile, i, j)->need = 1;
     acc->marked++;
 }
 
@@ -246,8 +258,9 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
         uint8_t *row0 = job->rgb + 3 * p0;
         for (size_t k = 1; k < w; k++)
             memcpy(row0 + 3 * k, row0, 3);
-        for (size_t k = 1; sh->probes && k < w; k++)
-            sh->probes[p0 + k] = sh->probes[p0];
+        aa_probe *pr0 = sh->tile ? tile_probe(sh->tile, i0, j0) : NULL;
+        for (size_t k = 1; pr0 && k < w; k++)
+            pr0[k] = pr0[0];
         for (uint32_t j = j0; j < j1; j++) {
             const size_t px = (size_t)j * cam->width + i0;
             if (j > j0)
@@ -261,14 +274,15 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
                 memset(job->normals_f + 3 * px, 0, 3 * w * sizeof(float));
             if (job->alpha)
                 memset(job->alpha + px, 0, w);
-            if (sh->probes)
-                memcpy(&sh->probes[px], &sh->probes[p0], w * sizeof *sh->probes);
+            if (pr0 && j > j0)
+                memcpy(tile_probe(sh->tile, i0, j), pr0, w * sizeof *pr0);
         }
         return;
     }
     for (unsigned sr = 0; sr < g.rows; sr++)
         for (unsigned sc = 0; sc < g.cols; sc++) {
             const double t_lo = g.t_lo[sr][sc];
+            const float start = tile_start(t_lo);
             if (!(t_lo < INFINITY)) { /* every ray of the sub-block misses: no direction */
                 for (uint32_t j = g.row[sr]; j < g.row[sr + 1]; j++)
                     for (uint32_t i = g.col[sc]; i < g.col[sc + 1]; i++)
@@ -295,10 +309,10 @@ static void render_block(const frame_shared *sh, frame_acc *acc, const trace_eye
                     trace_ray r;
                     const int traced =
                         trace_setup_eye(eye, dir, &r) && trace_clip(&r, t_lo, INFINITY);
-                    render_pixel(sh, acc, i, j, dir, traced ? &r : NULL, &an, t_lo);
+                    render_pixel(sh, acc, i, j, dir, traced ? &r : NULL, &an, start);
                 }
             }
-            if (sh->probes && job->beam_size && !job->no_beam_edge && acc->hits == hits0)
+            if (sh->tile && job->beam_size && !job->no_beam_edge && acc->hits == hits0)
                 mark_beam_edge(sh, acc, g.col[sc], g.col[sc + 1], g.row[sr], g.row[sr + 1]);
         }
 }
@@ -314,10 +328,13 @@ static void render_tile(const frame_shared *sh, frame_acc *acc, uint32_t tx, uin
     double us[FRAME_TILE]; /* camera_u of column i0 + k */
     trace_eye eye;
     trace_eye_init(job->tree, cam->eye, &eye); /* eye.ok = 0: every ray misses */
-    uint8_t *any = sh->tile_any ? &sh->tile_any[(size_t)ty * sh->tiles_x + tx] : NULL;
     if (sh->phase == 1) {
-        frame_supersample_tile(sh, acc, &eye, *any, i0, i1, j0, j1);
+        frame_aa_border(sh, acc, &eye, tx, ty, i0, i1, j0, j1);
         return;
+    }
+    if (sh->tile) {
+        sh->tile->i0 = i0;
+        sh->tile->j0 = j0;
     }
     const uint64_t hits0 = acc->hits, marked0 = acc->marked;
     for (uint32_t i = i0; i < i1; i++)
@@ -326,8 +343,9 @@ static void render_tile(const frame_shared *sh, frame_acc *acc, uint32_t tx, uin
         for (uint32_t bi = i0; bi < i1; bi += bs)
             render_block(sh, acc, &eye, us, i0, bi, bi + bs < i1 ? bi + bs : i1, bj,
                          bj + bs < j1 ? bj + bs : j1);
-    if (any)
-        *any = acc->hits != hits0 || acc->marked != marked0;
+    if (sh->tile)
+        frame_aa_tile(sh, acc, &eye, acc->hits != hits0 || acc->marked != marked0, tx, ty, i0, i1,
+                      j0, j1);
 }
 
 static void work(const frame_shared *common, int caller)
@@ -336,6 +354,8 @@ static void work(const frame_shared *common, int caller)
     frame_shared *sh = &mine;
     frame_sync *sy = sh->sync;
     frame_job own; /* with --exact: the job with this thread's exact worker */
+    frame_tile tile; /* with --aa: the probes of the tile being rendered */
+    sh->tile = sh->border ? &tile : NULL;
     if (sy->exact) {
         own = *sh->job;
         own.opts.exact = &sy->exact[atomic_fetch_add(&sy->next_exact, 1)];
@@ -370,7 +390,8 @@ static void work(const frame_shared *common, int caller)
     sy->sum.secondary_steps += acc.secondary_steps;
     sy->sum.shadow_ns += acc.shadow_ns;
     sy->sum.ao_ns += acc.ao_ns;
-    sy->pass_ns[sh->phase] += ns - acc.shadow_ns - acc.ao_ns;
+    sy->sum.sample_ns += acc.sample_ns;
+    sy->pass_ns += ns - acc.shadow_ns - acc.ao_ns;
     pthread_mutex_unlock(&sy->lock);
 }
 
@@ -475,6 +496,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
     atomic_init(&sy.next_exact, 0);
     pthread_mutex_init(&sy.lock, NULL);
     const size_t npx = (size_t)job->cam->width * job->cam->height;
+    const size_t ntiles = (size_t)sh.tiles_x * sh.tiles_y;
     int rc = 0;
     shadow_map smap;
     if (job->shade.shadows) {
@@ -487,24 +509,24 @@ int frame_render(const frame_job *job, frame_stats *stats)
             sy.sum.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
     }
     if (job->aa > 1) {
-        sh.probes = frame_probes_alloc(npx);
-        sh.tile_any = calloc((size_t)sh.tiles_x * sh.tiles_y, 1);
-        if (!sh.probes || !sh.tile_any) {
-            frame_probes_free(sh.probes, npx);
-            free(sh.tile_any);
-            sh.probes = NULL;
-            sh.tile_any = NULL;
+        sh.border = frame_border_alloc(ntiles);
+        sh.border_hit = malloc(ntiles ? ntiles : 1);
+        if (!sh.border || !sh.border_hit) {
+            frame_border_free(sh.border, ntiles);
+            free(sh.border_hit);
+            sh.border = NULL;
+            sh.border_hit = NULL;
             rc = ENOMEM; /* one ray a pixel */
         }
     }
     int rc1 = run_pass(&sh, 0);
-    if (sh.probes && !atomic_load(&sy.changed)) {
+    if (sh.border && !atomic_load(&sy.changed)) {
         int rc2 = run_pass(&sh, 1);
         if (!rc1)
             rc1 = rc2;
     }
-    frame_probes_free(sh.probes, npx);
-    free(sh.tile_any);
+    frame_border_free(sh.border, ntiles);
+    free(sh.border_hit);
     if (job->shade.shadows)
         shadow_map_free(&smap);
     exact_workers_free(&sy, job);
@@ -520,9 +542,9 @@ int frame_render(const frame_job *job, frame_stats *stats)
     stats->shadow_ns = sy.sum.shadow_ns;
     stats->ao_ns = sy.sum.ao_ns;
     stats->secondary_ns = sy.sum.shadow_ns + sy.sum.ao_ns;
-    stats->centre_ns = sy.pass_ns[0];
-    stats->sample_ns = sy.pass_ns[1];
-    stats->primary_ns = sy.pass_ns[0] + sy.pass_ns[1];
+    stats->centre_ns = sy.pass_ns - sy.sum.sample_ns;
+    stats->sample_ns = sy.sum.sample_ns;
+    stats->primary_ns = sy.pass_ns;
     stats->samples = sy.sum.rays;
     stats->file_changed = atomic_load(&sy.changed);
     return rc ? rc : rc1;

@@ -14,9 +14,21 @@ typedef struct frame_acc {
     uint64_t rays, hits, steps, aa_pixels, aa_full, shadow_rays, ao_rays, secondary_steps;
     uint64_t marked; /* sub-blocks marked by the beam's edge trigger */
     double shadow_ns, ao_ns;
+    double sample_ns; /* with timing: in the antialiasing samples, their secondary rays' left out */
     shadow_start start; /* the last hit's secondary start: its anchor is the
                            next one's search hint (start.near) */
 } frame_acc;
+
+/* A thread's probes of the tile it renders (the edge test's input). */
+typedef struct frame_tile {
+    uint32_t i0, j0; /* the tile's first pixel */
+    aa_probe p[FRAME_TILE * FRAME_TILE]; /* pixel (i, j) at (j - j0) * FRAME_TILE + i - i0 */
+} frame_tile;
+
+/* The probes a tile keeps for the pairs that straddle two tiles, each tile
+ * FRAME_BORDER of them: its top row, bottom row, left and right columns,
+ * FRAME_TILE slots each (a corner is in two). */
+#define FRAME_BORDER (4 * FRAME_TILE)
 
 typedef struct frame_sync frame_sync; /* frame.c's */
 
@@ -25,11 +37,12 @@ typedef struct frame_sync frame_sync; /* frame.c's */
 typedef struct frame_shared {
     const frame_job *job;
     trace_traverse_fn traverse;
-    aa_probe *probes; /* centre rays, for the antialiasing pass; NULL without */
-    uint8_t *tile_any; /* with probes: per tile, 1 when a centre ray hit or a
-                          sub-block was marked (supersample_tile) */
+    frame_tile *tile; /* with --aa: this thread's tile probes; NULL without */
+    aa_probe *border; /* with tile: FRAME_BORDER probes a tile, tiles in row order */
+    uint8_t *border_hit; /* with border: per tile, bit s when a probe of side s hit */
     const shadow_map *shadow_map; /* with --shadows: the light's map, or NULL */
-    int phase;        /* 0: centre rays; 1: samples where needed */
+    int phase;        /* 0: centre rays, then the samples a tile's own pixels
+                         ask for; 1: those the pairs across tiles ask for */
     uint32_t tiles_x, tiles_y;
     frame_sync *sync;
 } frame_shared;
@@ -47,16 +60,21 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
                         const double dir[3], uint32_t i, uint32_t j, unsigned ao_k0,
                         unsigned ao_count, unsigned ao_total, float rgb[3], float n[3]);
 
-/* The probes of an image of n pixels, zeroed (NULL when they cannot be
- * had), and their release (accepts NULL). */
-aa_probe *frame_probes_alloc(size_t n);
-void frame_probes_free(aa_probe *p, size_t n);
+/* The probes of n tile borders (FRAME_BORDER each), NULL when they cannot
+ * be had, and their release (accepts NULL). */
+aa_probe *frame_border_alloc(size_t n);
+void frame_border_free(aa_probe *p, size_t n);
 
-/* The antialiasing pass over the pixels [i0, i1) x [j0, j1) of a tile:
- * samples where the edge test asks for them. any: the tile's centre rays
- * hit or the beam marked one of its sub-blocks (else only its border
- * pixels are tested). */
-void frame_supersample_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
-                            uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1);
+/* The end of tile (tx, ty)'s first pass, [i0, i1) x [j0, j1), its probes
+ * in sh->tile: the edge test of the pairs inside it (when `any`: a centre
+ * ray hit or the beam marked a sub-block; else none differs), samples for
+ * the pixels that need them, the border probes kept. */
+void frame_aa_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
+                   uint32_t tx, uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1);
+
+/* The second pass over tile (tx, ty): samples for its border pixels that
+ * only a pixel of a neighbouring tile tells apart. */
+void frame_aa_border(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t tx,
+                     uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1);
 
 #endif

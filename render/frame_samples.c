@@ -1,7 +1,8 @@
-/* frame_samples: the antialiasing pass of a frame (RENDER.md,
- * "Antialiasing"): the pixels the edge test picks, traced again with
- * samples from their beam sub-block's start: as packets under the paper's
- * rule (trace_packet.h), else one by one from the pixel's anchor. */
+/* frame_samples: the antialiasing of a frame (RENDER.md, "Antialiasing"):
+ * the edge test inside each tile and across tile borders, and the pixels it
+ * picks traced again with samples from their beam sub-block's start: as
+ * packets under the paper's rule (trace_packet.h), else one by one from the
+ * pixel's anchor. */
 #include "render/frame_impl.h"
 
 #include <math.h>
@@ -11,49 +12,46 @@
 #include "render/beam.h"
 #include "render/trace_packet.h"
 
-/* A megapixel's probes are 24 MB, whose first touch in the centre pass
- * took some 6 000 page faults (13 ms of system time at 1024^2,
- * docs/perf-log.md): large ones are mapped asking for huge pages. */
-#define PROBES_MAPPED (UINT64_C(1) << 21)
+/* The border probes of a megapixel are 3 MB, whose first touch costs some
+ * 750 page faults: large ones are mapped asking for huge pages. */
+#define BORDER_MAPPED (UINT64_C(1) << 21)
 
-aa_probe *frame_probes_alloc(size_t n)
+aa_probe *frame_border_alloc(size_t n)
 {
-    const size_t bytes = n * sizeof(aa_probe);
-    if (n > SIZE_MAX / sizeof(aa_probe))
+    if (n > SIZE_MAX / (FRAME_BORDER * sizeof(aa_probe)))
         return NULL;
+    const size_t bytes = n * FRAME_BORDER * sizeof(aa_probe);
 #if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
-    if (bytes >= PROBES_MAPPED) {
+    if (bytes >= BORDER_MAPPED) {
         void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
         if (p == MAP_FAILED)
             return NULL;
         (void)madvise(p, bytes, MADV_HUGEPAGE); /* a hint: no huge pages is fine */
-        return p; /* zeroed */
+        return p;
     }
 #endif
-    return calloc(n, sizeof(aa_probe));
+    return malloc(bytes ? bytes : 1);
 }
 
-void frame_probes_free(aa_probe *p, size_t n)
+void frame_border_free(aa_probe *p, size_t n)
 {
     if (!p)
         return;
 #if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
-    if (n * sizeof(aa_probe) >= PROBES_MAPPED) {
-        munmap(p, n * sizeof(aa_probe));
+    if (n * FRAME_BORDER * sizeof(aa_probe) >= BORDER_MAPPED) {
+        munmap(p, n * FRAME_BORDER * sizeof(aa_probe));
         return;
     }
 #endif
     free(p);
 }
 
-/* Where the samples of pixel (i, j) may start (+inf: they all miss): its
- * sub-block's start, since a sub-block's pyramid holds its pixels' whole
- * squares (beam.h); --beam 0 starts at the eye. */
-static double sample_start(const frame_shared *sh, uint32_t i, uint32_t j)
+/* Where the samples of the pixel of centre probe c may start (+inf: they
+ * all miss): its sub-block's start, since a sub-block's pyramid holds its
+ * pixels' whole squares (beam.h); --beam 0 starts at the eye. */
+static double sample_start(const frame_shared *sh, const aa_probe *c)
 {
-    if (!sh->job->beam_size)
-        return 0.0;
-    return sh->probes[(size_t)j * sh->job->cam->width + i].t_lo;
+    return sh->job->beam_size ? (double)c->t_lo : 0.0;
 }
 
 /* The anchor of pixel (i, j)'s samples, which all start at t_lo: the
@@ -76,22 +74,27 @@ static void sample_anchor(const frame_shared *sh, const trace_eye *eye, uint32_t
     trace_anchor_find(sh->job->tree, lo, hi, an);
 }
 
-/* What the samples of one pixel share: where they start, and the anchor
- * the ones traced one by one start from (found when first needed). */
+/* What the samples of one pixel share: where they start, the anchor the
+ * ones traced one by one start from (found when first needed), and their
+ * sums so far. */
 typedef struct pixel_samples {
     const trace_eye *eye;
+    const aa_probe *cp; /* the centre ray's probe */
     uint32_t i, j;
     double t_lo;
     int packets;       /* the paper's rule: samples walked as packets */
     int anchor_found;
     trace_anchor an;
+    float sum[3];
+    unsigned hits, done;
+    int uniform;       /* every sample so far agrees with the centre ray */
 } pixel_samples;
 
-/* Samples ks[0..n) (n <= TRACE_PACKET_MAX) of the pixel (aa.h's order),
- * traced from t_lo: their directions and hits. As one packet when they
- * fit one (trace_packet.h: the same hits as traced alone), else one by
- * one from the pixel's anchor. */
-static void trace_samples(const frame_shared *sh, pixel_samples *ps, const unsigned *ks,
+/* Samples ks[0..n) (n <= TRACE_PACKET_MAX; sample q of pixel pss[q], in
+ * aa.h's order), each traced from its pixel's t_lo: their directions and
+ * hits. As one packet when they fit one (trace_packet.h: the same hits as
+ * traced alone), else one by one from their pixel's anchor. */
+static void trace_samples(const frame_shared *sh, pixel_samples *const *pss, const unsigned *ks,
                           unsigned n, double (*dir)[3], trace_hit *hits)
 {
     const frame_job *job = sh->job;
@@ -101,6 +104,7 @@ static void trace_samples(const frame_shared *sh, pixel_samples *ps, const unsig
     trace_ray r[TRACE_PACKET_MAX];
     unsigned slot[TRACE_PACKET_MAX], m = 0;
     for (unsigned q = 0; q < n; q++) {
+        const pixel_samples *ps = pss[q];
         double fx, fy;
         aa_sample_offset(na, ks[q], &fx, &fy);
         const double u = (2.0 * ((double)ps->i + fx) / w - 1.0) * cam->h * w / hh;
@@ -113,35 +117,63 @@ static void trace_samples(const frame_shared *sh, pixel_samples *ps, const unsig
             trace_clip(&r[m], ps->t_lo, INFINITY))
             slot[m++] = q;
     }
-    if (ps->packets && trace_packet_fits(r, m)) {
+    if (n && pss[0]->packets && trace_packet_fits(r, m)) {
         trace_hit ph[TRACE_PACKET_MAX];
         trace_packet_first(job->tree, r, m, ph);
         for (unsigned k = 0; k < m; k++)
             hits[slot[k]] = ph[k];
         return;
     }
-    if (m && !ps->anchor_found) {
-        sample_anchor(sh, ps->eye, ps->i, ps->j, ps->t_lo, &ps->an);
-        ps->anchor_found = 1;
-    }
-    for (unsigned k = 0; k < m; k++)
+    for (unsigned k = 0; k < m; k++) {
+        pixel_samples *ps = pss[slot[k]];
+        if (!ps->anchor_found) {
+            sample_anchor(sh, ps->eye, ps->i, ps->j, ps->t_lo, &ps->an);
+            ps->anchor_found = 1;
+        }
         sh->traverse(job->tree, &job->opts, &r[k], &ps->an, &hits[slot[k]]);
+    }
 }
 
-/* Pixel (i, j) again with samples (aa.h): the four corner samples of the
- * N x N grid first; when they and the centre ray all agree by the edge
- * rule, the pixel holds no edge and they are its colour; otherwise all
- * N x N. Each is shaded as a pixel is (AO rays k * per .. of per * N^2
- * for sample k), in the order of k within each of the two sets; colours
- * averaged in linear light. */
+/* Shades sample k of pixel ps (hit h along dir; AO rays k * per .. of
+ * per * N^2) and adds it to the pixel's sums. */
+static void add_sample(const frame_shared *sh, frame_acc *acc, pixel_samples *ps, unsigned k,
+                       const trace_hit *h, const double dir[3], unsigned per)
+{
+    const frame_job *job = sh->job;
+    float rgb[3];
+    aa_probe p;
+    acc->rays++;
+    acc->steps += h->steps;
+    frame_shade_sample(sh, acc, h, dir, ps->i, ps->j, k * per, per, per * job->aa * job->aa, rgb,
+                       p.n);
+    p.hit = (uint8_t)h->hit;
+    p.t = h->hit ? (float)h->t : INFINITY;
+    p.surface = shade_surface(job->tree, h);
+    ps->uniform &= !aa_differs(&p, ps->cp);
+    ps->hits += p.hit;
+    if (p.hit || !job->alpha)
+        for (int a = 0; a < 3; a++)
+            ps->sum[a] += rgb[a];
+}
+
+/* Pixels whose corner samples share a packet. */
+#define RUN_MAX (TRACE_PACKET_MAX / 4)
+
+/* Pixels (i + q, j), q < n (n <= RUN_MAX; centre probes cp[q]), again with
+ * samples (aa.h): the four corner samples of the N x N grid first, those
+ * of the n pixels in one walk; a pixel whose corners and centre ray all
+ * agree by the edge rule holds no edge and they are its colour; the others
+ * get all N x N, their other samples (in increasing k) traced pixel by
+ * pixel. Each sample is shaded as a pixel is; a pixel's colours are added
+ * in the order of k within each of the two sets and averaged in linear
+ * light. */
 static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t i,
-                        uint32_t j)
+                        uint32_t j, unsigned n, const aa_probe *cp)
 {
     const frame_job *job = sh->job;
     const camera *cam = job->cam;
     const unsigned na = job->aa, ns = na * na, ao = job->shade.ao_rays;
     const unsigned per = ao ? (ao / ns > 0 ? ao / ns : 1) : 0;
-    const size_t px = (size_t)j * cam->width + i;
     /* the corners, then the others, each set in increasing k */
     unsigned order[AA_MAX * AA_MAX], no = 0;
     const unsigned corner[4] = {0, na - 1, ns - na, ns - 1};
@@ -150,66 +182,151 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     for (unsigned k = 0; k < ns; k++)
         if (k != corner[0] && k != corner[1] && k != corner[2] && k != corner[3])
             order[no++] = k;
-    pixel_samples ps;
-    ps.eye = eye;
-    ps.i = i;
-    ps.j = j;
-    ps.t_lo = sample_start(sh, i, j);
-    ps.packets = !job->exact && !job->opts.refine && !job->no_packets;
-    ps.anchor_found = 0;
-    float sum[3] = {0.0f, 0.0f, 0.0f};
-    unsigned hits = 0, done = 0;
-    int uniform = 1;
-    while (done < ns) {
-        const unsigned end = done < 4 ? 4 : ns; /* the corners, then the rest */
-        for (unsigned q0 = done; q0 < end; q0 += TRACE_PACKET_MAX) {
-            const unsigned n = end - q0 < TRACE_PACKET_MAX ? end - q0 : TRACE_PACKET_MAX;
-            double dir[TRACE_PACKET_MAX][3];
-            trace_hit h[TRACE_PACKET_MAX];
-            trace_samples(sh, &ps, order + q0, n, dir, h);
-            for (unsigned q = 0; q < n; q++) {
-                const unsigned k = order[q0 + q];
-                float rgb[3];
-                aa_probe p;
-                acc->rays++;
-                acc->steps += h[q].steps;
-                frame_shade_sample(sh, acc, &h[q], dir[q], i, j, k * per, per, per * ns, rgb,
-                                   p.n);
-                p.hit = (uint8_t)h[q].hit;
-                p.t = h[q].hit ? (float)h[q].t : INFINITY;
-                p.surface = shade_surface(job->tree, &h[q]);
-                uniform &= !aa_differs(&p, &sh->probes[px]);
-                hits += p.hit;
-                if (p.hit || !job->alpha)
-                    for (int a = 0; a < 3; a++)
-                        sum[a] += rgb[a];
+    pixel_samples ps[RUN_MAX], *pss[TRACE_PACKET_MAX];
+    unsigned ks[TRACE_PACKET_MAX];
+    double dir[TRACE_PACKET_MAX][3];
+    trace_hit h[TRACE_PACKET_MAX];
+    for (unsigned q = 0; q < n; q++) {
+        pixel_samples *p = &ps[q];
+        p->eye = eye;
+        p->cp = &cp[q];
+        p->i = i + q;
+        p->j = j;
+        p->t_lo = sample_start(sh, &cp[q]);
+        p->packets = !job->exact && !job->opts.refine && !job->no_packets;
+        p->anchor_found = 0;
+        p->sum[0] = p->sum[1] = p->sum[2] = 0.0f;
+        p->hits = 0;
+        p->done = 4;
+        p->uniform = 1;
+        for (unsigned c = 0; c < 4; c++) {
+            pss[4 * q + c] = p;
+            ks[4 * q + c] = order[c];
+        }
+    }
+    trace_samples(sh, pss, ks, 4 * n, dir, h);
+    for (unsigned s = 0; s < 4 * n; s++)
+        add_sample(sh, acc, pss[s], ks[s], &h[s], dir[s], per);
+    for (unsigned q = 0; q < n; q++) {
+        pixel_samples *p = &ps[q];
+        if (!p->uniform) {
+            for (unsigned q0 = 4; q0 < ns; q0 += TRACE_PACKET_MAX) {
+                const unsigned m = ns - q0 < TRACE_PACKET_MAX ? ns - q0 : TRACE_PACKET_MAX;
+                for (unsigned s = 0; s < m; s++)
+                    pss[s] = p;
+                trace_samples(sh, pss, order + q0, m, dir, h);
+                for (unsigned s = 0; s < m; s++)
+                    add_sample(sh, acc, p, order[q0 + s], &h[s], dir[s], per);
+            }
+            p->done = ns;
+        }
+        const size_t px = (size_t)j * cam->width + p->i;
+        const float div = job->alpha ? (float)(p->hits ? p->hits : 1) : (float)p->done;
+        for (int a = 0; a < 3; a++)
+            job->rgb[3 * px + (size_t)a] = frame_srgb8_ready(p->sum[a] / div);
+        if (job->alpha)
+            job->alpha[px] = (uint8_t)((p->hits * 255u + p->done / 2) / p->done);
+        acc->aa_pixels++;
+        acc->aa_full += p->done == ns;
+    }
+}
+
+/* Sides of a tile's border probes (frame_impl.h). */
+enum { TOP, BOTTOM, LEFT, RIGHT };
+
+static aa_probe *border_of(const frame_shared *sh, uint32_t tx, uint32_t ty)
+{
+    return sh->border + ((size_t)ty * sh->tiles_x + tx) * FRAME_BORDER;
+}
+
+/* Adds the thread time since t0 to the samples', less the secondary rays'
+ * time since their sum was sec0. */
+static void sample_time(const frame_shared *sh, frame_acc *acc, double t0, double sec0)
+{
+    if (sh->job->timing)
+        acc->sample_ns += frame_now_ns() - t0 - (acc->shadow_ns + acc->ao_ns - sec0);
+}
+
+void frame_aa_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
+                   uint32_t tx, uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+{
+    const double t0 = sh->job->timing ? frame_now_ns() : 0.0, sec0 = acc->shadow_ns + acc->ao_ns;
+    aa_probe *const tp = sh->tile->p;
+    const uint32_t w = i1 - i0, h = j1 - j0;
+    if (any) {
+        aa_mark_inside(tp, FRAME_TILE, w, h);
+        for (uint32_t j = 0; j < h; j++) {
+            const aa_probe *row = &tp[(size_t)j * FRAME_TILE];
+            for (uint32_t i = 0; i < w;) {
+                if (!row[i].need) {
+                    i++;
+                    continue;
+                }
+                unsigned n = 1; /* a run of pixels that need samples */
+                while (n < RUN_MAX && i + n < w && row[i + n].need)
+                    n++;
+                supersample(sh, acc, eye, i0 + i, j0 + j, n, &row[i]);
+                i += n;
             }
         }
-        done = end;
-        if (done == 4 && uniform)
-            break;
     }
-    const float div = job->alpha ? (float)(hits ? hits : 1) : (float)done;
-    for (int a = 0; a < 3; a++)
-        job->rgb[3 * px + (size_t)a] = frame_srgb8_ready(sum[a] / div);
-    if (job->alpha)
-        job->alpha[px] = (uint8_t)((hits * 255u + done / 2) / done);
-    acc->aa_pixels++;
-    acc->aa_full += done == ns;
+    aa_probe *b = border_of(sh, tx, ty);
+    unsigned hit[4] = {0, 0, 0, 0};
+    for (uint32_t k = 0; k < w; k++) {
+        hit[TOP] |= (b[TOP * FRAME_TILE + k] = tp[k]).hit;
+        hit[BOTTOM] |= (b[BOTTOM * FRAME_TILE + k] = tp[(size_t)(h - 1) * FRAME_TILE + k]).hit;
+    }
+    for (uint32_t k = 0; k < h; k++) {
+        hit[LEFT] |= (b[LEFT * FRAME_TILE + k] = tp[(size_t)k * FRAME_TILE]).hit;
+        hit[RIGHT] |= (b[RIGHT * FRAME_TILE + k] = tp[(size_t)k * FRAME_TILE + w - 1]).hit;
+    }
+    sh->border_hit[(size_t)ty * sh->tiles_x + tx] =
+        (uint8_t)(hit[TOP] << TOP | hit[BOTTOM] << BOTTOM | hit[LEFT] << LEFT | hit[RIGHT] << RIGHT);
+    sample_time(sh, acc, t0, sec0);
 }
 
-/* The antialiasing pass over [i0, i1) x [j0, j1): samples where needed. */
-void frame_supersample_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
-                            uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
+void frame_aa_border(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t tx,
+                     uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
 {
+    const double t0 = sh->job->timing ? frame_now_ns() : 0.0, sec0 = acc->shadow_ns + acc->ao_ns;
     const camera *cam = sh->job->cam;
+    const aa_probe *b = border_of(sh, tx, ty);
+    /* the facing sides of the four neighbouring tiles, where there are and
+       one of the two sides has a hit (two misses never differ) */
+    const uint8_t *bh = sh->border_hit, mine = bh[(size_t)ty * sh->tiles_x + tx];
+    const size_t t = (size_t)ty * sh->tiles_x + tx;
+    const aa_probe *up = ty > 0 && (mine >> TOP & 1u || bh[t - sh->tiles_x] >> BOTTOM & 1u)
+                             ? border_of(sh, tx, ty - 1) + BOTTOM * FRAME_TILE
+                             : NULL;
+    const aa_probe *down = j1 < cam->height && (mine >> BOTTOM & 1u || bh[t + sh->tiles_x] >> TOP & 1u)
+                               ? border_of(sh, tx, ty + 1) + TOP * FRAME_TILE
+                               : NULL;
+    const aa_probe *left = tx > 0 && (mine >> LEFT & 1u || bh[t - 1] >> RIGHT & 1u)
+                               ? border_of(sh, tx - 1, ty) + RIGHT * FRAME_TILE
+                               : NULL;
+    const aa_probe *right = i1 < cam->width && (mine >> RIGHT & 1u || bh[t + 1] >> LEFT & 1u)
+                                ? border_of(sh, tx + 1, ty) + LEFT * FRAME_TILE
+                                : NULL;
+    if (!up && !down && !left && !right)
+        return;
     for (uint32_t j = j0; j < j1; j++) {
-        /* a tile without hits or marks: only its border pixels have a
-           neighbour that may differ (in the next tile) */
-        const uint32_t step = any || j == j0 || j + 1 == j1 || i1 - i0 < 2 ? 1 : i1 - i0 - 1;
-        for (uint32_t i = i0; i < i1; i += step)
-            if (aa_needs(sh->probes, cam->width, cam->height, i, j))
-                supersample(sh, acc, eye, i, j);
+        const uint32_t m = j - j0;
+        /* the outer rows whole, of the others the two outer columns */
+        const uint32_t step = j == j0 || j + 1 == j1 || i1 - i0 < 2 ? 1 : i1 - i0 - 1;
+        for (uint32_t i = i0; i < i1; i += step) {
+            const uint32_t k = i - i0;
+            const aa_probe *p = j == j0       ? &b[TOP * FRAME_TILE + k]
+                                : j + 1 == j1 ? &b[BOTTOM * FRAME_TILE + k]
+                                : i == i0     ? &b[LEFT * FRAME_TILE + m]
+                                              : &b[RIGHT * FRAME_TILE + m];
+            if (p->need) /* sampled by the first pass */
+                continue;
+            if ((j == j0 && up && aa_differs(p, &up[k])) ||
+                (j + 1 == j1 && down && aa_differs(p, &down[k])) ||
+                (i == i0 && left && aa_differs(p, &left[m])) ||
+                (i + 1 == i1 && right && aa_differs(p, &right[m])))
+                supersample(sh, acc, eye, i, j, 1, p);
+        }
     }
+    sample_time(sh, acc, t0, sec0);
 }
-

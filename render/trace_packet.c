@@ -32,8 +32,8 @@ typedef struct child_lanes {
     _Alignas(16) double lo[8][LANES];
     _Alignas(16) double hi[8][LANES];
     uint32_t lanes[8]; /* node_steps: the lanes in child k */
-    uint32_t pairs;    /* node_steps_sse2: bit 2q for each pair q computed, */
-    uint16_t w[LANES / 2]; /* and its lanes: bit 2k + l for lane 2q + l in child k */
+    uint64_t w[LANES / 8]; /* node_steps_sse2: bit 16 (q % 4) + 2k + l of w[q / 4]
+                              for lane 2q + l in child k (pair q), 0 elsewhere */
 } child_lanes;
 
 int trace_packet_fits(const trace_ray *r, unsigned n)
@@ -125,6 +125,7 @@ static unsigned node_steps_sse2(const packet *p, const uint32_t c[3], uint32_t h
     const __m128d km2 = _mm_set1_pd((double)(c[2] + half));
     const uint32_t pairs = (live | live >> 1) & UINT32_C(0x55555555);
     unsigned any = 0;
+    ch->w[0] = ch->w[1] = 0;
     for (uint32_t b = pairs; b; b &= b - 1u) {
         const unsigned s = (unsigned)__builtin_ctz(b);
         const __m128d lo = _mm_load_pd(nlo + s), hi = _mm_load_pd(nhi + s);
@@ -170,10 +171,9 @@ static unsigned node_steps_sse2(const packet *p, const uint32_t c[3], uint32_t h
         static const uint16_t of_lanes[4] = {0, 0x5555u, 0xaaaau, 0xffffu};
         const unsigned w = (unsigned)_mm_movemask_epi8(_mm_packs_epi16(p0, p1)) &
                            of_lanes[live >> s & 3u];
-        ch->w[s >> 1] = (uint16_t)w;
+        ch->w[s >> 3] |= (uint64_t)w << (16u * (s >> 1 & 3u));
         any |= w;
     }
-    ch->pairs = pairs;
     /* child k is touched when bit 2k or 2k + 1 of `any` is set */
     unsigned touched = (any | any >> 1) & 0x5555u;
     touched = (touched | touched >> 1) & 0x3333u;
@@ -182,15 +182,21 @@ static unsigned node_steps_sse2(const packet *p, const uint32_t c[3], uint32_t h
     return touched;
 }
 
-/* The lanes node_steps_sse2 put in child k. */
+/* The lanes node_steps_sse2 put in child k: the 2-bit group 2k of each
+ * pair's 16 bits, four pairs a word, gathered by one multiplication. After
+ * the mask, pair q's group is at bit 16q; the product's term for pair q and
+ * factor 2^(48 - 14j) lands at bit 48 + 16q - 14j, and only j = q puts a
+ * term in bits 48..55 (at 48 + 2q); the terms' 2-bit fields never overlap,
+ * so nothing carries. */
+_Static_assert(LANES == 16, "pair_lanes gathers two words of four pairs");
+
 static inline uint32_t pair_lanes(const child_lanes *ch, unsigned k)
 {
-    uint32_t m = 0;
-    for (uint32_t b = ch->pairs; b; b &= b - 1u) {
-        const unsigned s = (unsigned)__builtin_ctz(b);
-        m |= (uint32_t)(ch->w[s >> 1] >> (2u * k) & 3u) << s;
-    }
-    return m;
+    const uint64_t groups = UINT64_C(0x0003000300030003);
+    const uint64_t gather = UINT64_C(1) << 48 | UINT64_C(1) << 34 | UINT64_C(1) << 20 | UINT64_C(1) << 6;
+    const uint64_t lo = ((ch->w[0] >> (2u * k) & groups) * gather) >> 48 & 0xffu;
+    const uint64_t hi = ((ch->w[1] >> (2u * k) & groups) * gather) >> 48 & 0xffu;
+    return (uint32_t)(lo | hi << 8);
 }
 #endif
 
@@ -287,7 +293,8 @@ static void packet_first(const oct_tree *tree, const trace_ray *r, unsigned n, t
                 p.flip |= 1u << a;
     _Alignas(16) double lo[LANES], hi[LANES];
     uint32_t live = 0;
-    for (unsigned s = 0; s < LANES; s++) {
+    /* the SSE2 steps read lanes in pairs: the lane past an odd n too */
+    for (unsigned s = 0; s < n + (n & 1u); s++) {
         if (s >= n) { /* no ray: finite values, an empty interval */
             for (unsigned a = 0; a < 3; a++) {
                 p.zo[a][s] = 0.5;

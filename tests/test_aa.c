@@ -187,21 +187,94 @@ static void test_edge_rule(void **state)
     b.n[0] = 0.3f; /* 17 degrees */
     b.n[2] = 0.954f;
     assert_false(aa_differs(&a, &b));
-    /* a pixel of a sub-block the beam marked needs samples, its
-       neighbours all alike */
-    aa_probe grid[9];
-    for (int k = 0; k < 9; k++) {
+    /* inside a rectangle: each pixel that differs from a 4-neighbour
+       inside it, a mark kept, nothing across its sides */
+    aa_probe grid[4 * 3];
+    for (int k = 0; k < 12; k++) {
         grid[k] = a;
         grid[k].hit = 0;
     }
-    assert_false(aa_needs(grid, 3, 3, 1, 1));
-    grid[4].beam_edge = 1;
-    assert_true(aa_needs(grid, 3, 3, 1, 1));
-    assert_false(aa_needs(grid, 3, 3, 0, 0));
+    grid[0].need = 1;     /* a beam mark stays */
+    grid[6].hit = 1;      /* (2, 1) of the 3 x 3 at stride 4 */
+    grid[3].hit = 1;      /* column 3: outside it */
+    aa_mark_inside(grid, 4, 3, 3);
+    for (int k = 0; k < 12; k++)
+        assert_int_equal(grid[k].need, k == 0 || k == 6 || k == 2 || k == 5 || k == 10);
     aa_probe m1 = a, m2 = a; /* two misses never differ */
     m1.hit = m2.hit = 0;
     m1.t = 1.0f;
     assert_false(aa_differs(&m1, &m2));
+}
+
+/* The pixels sampled are those the rule picks over the whole image
+ * (brute force on the centre rays' depth and normal), pairs across tile
+ * borders included: views whose silhouettes and a ball's inside cross
+ * tile borders, several beam sizes and thread counts. */
+static void test_edge_test_whole_image(void **state)
+{
+    (void)state;
+    const uint32_t w = 3 * FRAME_TILE - 7, h = 2 * FRAME_TILE + 9;
+    const size_t np = (size_t)w * h;
+    scene s = sphere_scene(7, 40.0, 150.0, 40.0);
+    camera cams[2];
+    const double c = 64.0, eye[3] = {c + 30.0, c - 20.0, c + 100.0}, target[3] = {c, c, c},
+                 up[3] = {0, 1, 0}, near[3] = {c + 10.0, c - 5.0, c + 42.0};
+    assert_int_equal(camera_init(&cams[0], eye, target, up, 40.0, w, h), CAMERA_OK);
+    assert_int_equal(camera_init(&cams[1], near, target, up, 60.0, w, h), CAMERA_OK);
+    uint8_t *rgb = malloc(np * 3);
+    float *depth = malloc(np * sizeof *depth), *nrm = malloc(np * 3 * sizeof *nrm);
+    aa_probe *pr = malloc(np * sizeof *pr);
+    assert_true(rgb && depth && nrm && pr);
+    for (int v = 0; v < 2; v++) {
+        frame_job job;
+        memset(&job, 0, sizeof job);
+        job.tree = s.tree;
+        job.cam = &cams[v];
+        job.opts.split = s.tree->levels;
+        job.shade.ambient = 0.2f;
+        shade_default_light(&cams[v], job.shade.light);
+        job.rgb = rgb;
+        job.depth = depth;
+        job.normals_f = nrm;
+        job.threads = 1;
+        job.beam_size = FRAME_BEAM_DEFAULT;
+        job.no_beam_edge = 1;
+        frame_stats st;
+        assert_int_equal(frame_render(&job, &st), 0);
+        for (size_t k = 0; k < np; k++) {
+            memset(&pr[k], 0, sizeof pr[k]);
+            pr[k].hit = depth[k] < INFINITY;
+            pr[k].t = depth[k];
+            for (int a = 0; a < 3; a++)
+                pr[k].n[a] = nrm[3 * k + (size_t)a];
+        }
+        uint64_t want = 0, across = 0;
+        for (uint32_t j = 0; j < h; j++)
+            for (uint32_t i = 0; i < w; i++) {
+                const aa_probe *p = &pr[(size_t)j * w + i];
+                const int l = i > 0 && aa_differs(p, p - 1), r = i + 1 < w && aa_differs(p, p + 1);
+                const int u = j > 0 && aa_differs(p, p - w), d = j + 1 < h && aa_differs(p, p + w);
+                want += l || r || u || d;
+                across += (l && i % FRAME_TILE == 0) || (u && j % FRAME_TILE == 0);
+            }
+        assert_true(across > 4);
+        job.depth = NULL;
+        job.normals_f = NULL;
+        job.aa = 2;
+        static const unsigned beams[] = {0, 5, FRAME_BEAM_DEFAULT};
+        for (size_t b = 0; b < sizeof beams / sizeof beams[0]; b++)
+            for (unsigned th = 1; th <= 3; th += 2) {
+                job.beam_size = beams[b];
+                job.threads = th;
+                assert_int_equal(frame_render(&job, &st), 0);
+                assert_int_equal(st.aa_pixels, want);
+            }
+    }
+    free(rgb);
+    free(depth);
+    free(nrm);
+    free(pr);
+    tree_util_free(s.tree);
 }
 
 /* Colour is averaged in linear light: half the samples on white, half on
@@ -428,6 +501,7 @@ int main(void)
         cmocka_unit_test(test_coverage_matches_disc),
         cmocka_unit_test(test_deterministic_and_centre_depth),
         cmocka_unit_test(test_edge_rule),
+        cmocka_unit_test(test_edge_test_whole_image),
         cmocka_unit_test(test_linear_average),
         cmocka_unit_test(test_beam_edge_trigger),
         cmocka_unit_test(test_sample_starts_exact),
