@@ -182,8 +182,10 @@ static void supersample(const frame_shared *sh, frame_acc *acc, const trace_eye 
     for (unsigned k = 0; k < ns; k++)
         if (k != corner[0] && k != corner[1] && k != corner[2] && k != corner[3])
             order[no++] = k;
-    pixel_samples ps[RUN_MAX], *pss[TRACE_PACKET_MAX];
-    unsigned ks[TRACE_PACKET_MAX];
+    /* pss and ks zeroed: their first 4n entries are set below, which gcc
+       at -O1 cannot see (-Wmaybe-uninitialized) */
+    pixel_samples ps[RUN_MAX], *pss[TRACE_PACKET_MAX] = {0};
+    unsigned ks[TRACE_PACKET_MAX] = {0};
     double dir[TRACE_PACKET_MAX][3];
     trace_hit h[TRACE_PACKET_MAX];
     for (unsigned q = 0; q < n; q++) {

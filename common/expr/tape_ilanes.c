@@ -49,13 +49,8 @@ void tape_eval_interval_lanes_on(int path, const tape *t, unsigned n,
                                  unsigned flags[], tape_ilanes *slots)
 {
     tape_ilanes b[3];
-    unsigned fl[TAPE_LANES] = {0}, w = n <= 4 ? 4 : TAPE_LANES; /* the lanes the pass runs */
-    for (unsigned k = 0; k < 3; k++)
-        for (unsigned l = 0; l < w; l++) {
-            const interval *src = &box[l < n ? l : 0][k];
-            b[k].lo[l] = src->lo;
-            b[k].hi[l] = src->hi;
-        }
+    unsigned fl[TAPE_LANES] = {0};
+    il_boxes_in_lanes(n, box, b);
 #if TAPE_ILANES_AVX2
     if (path == TAPE_PATH_AVX2)
         tape_ilanes_avx2(t, n, b, fl, slots);

@@ -44,6 +44,19 @@ static inline void igl_set(tape_idual_lanes *v, unsigned l, const tape_idual *x)
         il_set(&v->d[j], l, x->d[j]);
 }
 
+/* The boxes in lanes for one pass: lanes n.. repeat lane 0 up to the pass's
+ * width (4 or TAPE_LANES), so every lane of the pass computes a real box. */
+static inline void il_boxes_in_lanes(unsigned n, const interval box[][3], tape_ilanes b[3])
+{
+    const unsigned w = n <= 4 ? 4 : TAPE_LANES;
+    for (unsigned k = 0; k < 3; k++)
+        for (unsigned l = 0; l < w; l++) {
+            const interval *src = &box[l < n ? l : 0][k];
+            b[k].lo[l] = src->lo;
+            b[k].hi[l] = src->hi;
+        }
+}
+
 /* One build's evaluator: tape_eval_interval_lanes with the boxes already in
  * lanes (lanes n.. repeating lane 0) and fl[] cleared. */
 void tape_ilanes_portable(const tape *t, unsigned n, const tape_ilanes box[3],
