@@ -130,7 +130,7 @@ interval interval_log(interval a, unsigned *flags)
 }
 
 /* Beyond this magnitude trigonometric functions get their full range. */
-#define TRIG_MAX 1e8
+#define TRIG_MAX INTERVAL_TRIG_MAX
 
 /* May [lo, hi] contain phase + k*period for an integer k? Errs towards yes.
  * k = (x - phase) / period in double carries an absolute error below
@@ -171,27 +171,6 @@ static interval sin_or_cos(interval a, unsigned *flags, int is_cos)
 interval interval_sin(interval a, unsigned *flags) { return sin_or_cos(a, flags, 0); }
 interval interval_cos(interval a, unsigned *flags) { return sin_or_cos(a, flags, 1); }
 
-/* Up to this width interval_sincos uses the midpoint form: there its excess
- * width, about h^2 / 2 for a half-width h, is a few percent of the range at
- * most, and one sincos replaces the libm calls at both ends and the
- * extremum tests. */
-#define TRIG_TAYLOR_WIDTH 0.25
-
-/* Covers every rounding of interval_sincos's narrow form (see there). */
-#define SINCOS_MARGIN 0x1p-48
-
-/* The second-order form about m of sin (v = sin m, w = cos m) or of cos
- * (v = cos m, w = -sin m; only |w| matters), for |x - m| <= h and
- * (x - m)^2 / 2 <= q: v + w (x - m) - sigma (x - m)^2 / 2 with sigma
- * (sin xi, or cos xi) within h of v. */
-static interval sincos_form(double v, double w, double h, double q)
-{
-    double t1 = fabs(w) * h;
-    double sl = max2(v - h - 0x1p-50, -1.0), sh = min2(v + h + 0x1p-50, 1.0);
-    double rl = min2(0.0, -sh * q), rh = max2(0.0, -sl * q);
-    return clamp11(v - t1 + rl - SINCOS_MARGIN, v + t1 + rh + SINCOS_MARGIN);
-}
-
 /* For x and m in a, Taylor's theorem with the Lagrange remainder gives
  * sin x = sin m + cos m (x - m) - sin(xi) (x - m)^2 / 2 for some xi between
  * m and x, and |sin xi - sin m| <= |xi - m| <= h; likewise cos x = cos m -
@@ -202,30 +181,28 @@ static interval sincos_form(double v, double w, double h, double q)
  * in magnitude and there are five roundings, each within 2^-53: with the
  * libm errors (2^-52 in v, 2^-52 h through w, 2^-50 in sigma's bounds
  * times q <= 2^-5) the sums are within 2^-50 of the real bounds, well
- * inside SINCOS_MARGIN; so both enclosures are sound. */
+ * inside INTERVAL_SINCOS_MARGIN; so both enclosures are sound. */
 void interval_sincos(interval a, interval *so, interval *co, unsigned *flags)
 {
-    /* NaN, infinite ends (the difference is not <= the width), wide or far
-     * intervals: the endpoint forms. */
-    if (!(a.hi - a.lo <= TRIG_TAYLOR_WIDTH) || !(fabs(a.lo) <= TRIG_MAX && fabs(a.hi) <= TRIG_MAX)) {
+    if (!interval__sincos_narrow(a)) {
         if (so)
             *so = interval_sin(a, flags);
         if (co)
             *co = interval_cos(a, flags);
         return;
     }
-    double m = min2(max2(0.5 * a.lo + 0.5 * a.hi, a.lo), a.hi), sm, cm;
+    double m = interval__sincos_mid(a), sm, cm;
 #if defined(__GLIBC__)
     sincos(m, &sm, &cm);
 #else
     sm = sin(m);
     cm = cos(m);
 #endif
-    double h = max2(m - a.lo, a.hi - m) * (1.0 + 0x1p-50), q = 0.5 * h * h;
+    double h = interval__sincos_half(a, m), q = 0.5 * h * h;
     if (so)
-        *so = sincos_form(sm, cm, h, q);
+        *so = interval__sincos_form(sm, cm, h, q);
     if (co)
-        *co = sincos_form(cm, sm, h, q);
+        *co = interval__sincos_form(cm, sm, h, q);
 }
 
 interval interval_tan(interval a, unsigned *flags)

@@ -138,6 +138,42 @@ static inline interval interval__nan_flag(unsigned *flags)
     return interval__mk(NAN, NAN);
 }
 
+/* interval_sincos's narrow form, shared with the lane evaluators (the same
+ * operations, so the same bits). Up to this width it applies: there its
+ * excess width, about h^2 / 2 for a half-width h, is a few percent of the
+ * range at most, and one sincos replaces the libm calls at both ends and
+ * the extremum tests. NaN and infinite ends fail the width test. */
+#define INTERVAL_TRIG_TAYLOR_WIDTH 0.25
+#define INTERVAL_TRIG_MAX 1e8
+/* Covers every rounding of the narrow form (see interval_sincos). */
+#define INTERVAL_SINCOS_MARGIN 0x1p-48
+static inline int interval__sincos_narrow(interval a)
+{
+    return a.hi - a.lo <= INTERVAL_TRIG_TAYLOR_WIDTH && fabs(a.lo) <= INTERVAL_TRIG_MAX &&
+           fabs(a.hi) <= INTERVAL_TRIG_MAX;
+}
+static inline double interval__sincos_mid(interval a)
+{
+    return interval__min2(interval__max2(0.5 * a.lo + 0.5 * a.hi, a.lo), a.hi);
+}
+/* max |x - m| over a, raised by 2^-50 of itself (above its rounding). */
+static inline double interval__sincos_half(interval a, double m)
+{
+    return interval__max2(m - a.lo, a.hi - m) * (1.0 + 0x1p-50);
+}
+/* The second-order form about m of sin (v = sin m, w = cos m) or of cos
+ * (v = cos m, w = -sin m; only |w| matters), for |x - m| <= h and
+ * (x - m)^2 / 2 <= q: v + w (x - m) - sigma (x - m)^2 / 2 with sigma
+ * (sin xi, or cos xi) within h of v; clamped to [-1, 1]. */
+static inline interval interval__sincos_form(double v, double w, double h, double q)
+{
+    double t1 = fabs(w) * h;
+    double sl = interval__max2(v - h - 0x1p-50, -1.0), sh = interval__min2(v + h + 0x1p-50, 1.0);
+    double rl = interval__min2(0.0, -sh * q), rh = interval__max2(0.0, -sl * q);
+    double lo = v - t1 + rl - INTERVAL_SINCOS_MARGIN, hi = v + t1 + rh + INTERVAL_SINCOS_MARGIN;
+    return interval__mk(lo < -1.0 ? -1.0 : lo, hi > 1.0 ? 1.0 : hi);
+}
+
 /* True when i is the NaN interval. */
 static inline int interval_is_nan(interval i) { return interval__isnan(i); }
 

@@ -174,12 +174,32 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
     if (j == TRIG_MEMO) {
         j = m->next++ % TRIG_MEMO;
         m->arg[j] = slot;
+        /* interval_sincos in lanes: the narrow lanes' midpoints, one
+         * sincos each, then their forms side by side. */
+        double mid[W], sm[W], cm[W];
+        unsigned narrow = 0;
         for (unsigned l = 0; l < n; l++) {
-            interval sv, cv;
-            interval_sincos(il_get(a, l), &sv, &cv, &fl[l]);
-            il_set(&m->s[j], l, sv);
-            il_set(&m->c[j], l, cv);
+            interval x = il_get(a, l);
+            if (interval__sincos_narrow(x)) {
+                narrow |= 1u << l;
+                mid[l] = interval__sincos_mid(x);
+            } else {
+                interval sv, cv;
+                interval_sincos(x, &sv, &cv, &fl[l]);
+                il_set(&m->s[j], l, sv);
+                il_set(&m->c[j], l, cv);
+            }
         }
+        for (unsigned l = 0; l < n; l++)
+            if (narrow >> l & 1)
+                point_sincos(mid[l], &sm[l], &cm[l]);
+        for (unsigned l = 0; l < n; l++)
+            if (narrow >> l & 1) {
+                interval x = il_get(a, l);
+                double h = interval__sincos_half(x, mid[l]), q = 0.5 * h * h;
+                il_set(&m->s[j], l, interval__sincos_form(sm[l], cm[l], h, q));
+                il_set(&m->c[j], l, interval__sincos_form(cm[l], sm[l], h, q));
+            }
         for (unsigned l = n; l < W; l++) {
             m->s[j].lo[l] = m->s[j].lo[0];
             m->s[j].hi[l] = m->s[j].hi[0];
