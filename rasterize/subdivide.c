@@ -33,6 +33,15 @@ static void centre_values(worker *wk, const tape *t, unsigned n, const double *x
     tape_eval_grad_lanes(t, n, x, y, z, f, g, wk->lslots);
 }
 
+/* The tape for f at voxel centres: the full one, whose bits the records
+ * take; with --shell-only and one surface, where f serves only the centred
+ * re-test's skip (which only keeps voxels, its margin covering the pruned
+ * constants), the node's pruned one. */
+static const tape *centre_tape(const worker *wk, const tape *pruned, unsigned s)
+{
+    return wk->c->par->shell_only && wk->c->nsurf == 1 ? pruned : wk->c->full[s];
+}
+
 /* With --shell-only and one surface, f at a child's centre serves only the
  * centred re-test: the candidates (cand) where the node's form (fc at
  * centre c, G) shows that the re-test keeps the child whatever f is there
@@ -74,7 +83,7 @@ static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, const ui
         }
         if (!n)
             continue;
-        centre_values(wk, c->full[s], n, x, y, z, f, g);
+        centre_values(wk, centre_tape(wk, &wk->tapes[(size_t)pidx * ns + s], s), n, x, y, z, f, g);
         for (unsigned l = 0; l < n; l++) {
             double *fg = wk->cf8 + ((size_t)s * 8 + lane[l]) * 4;
             fg[0] = f[l];
@@ -342,7 +351,7 @@ static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
 {
     const build_ctx *c = wk->c;
     const unsigned pidx = depth + 1;
-    const tape *t = &wk->tapes[pidx], *full = c->full[0];
+    const tape *t = &wk->tapes[pidx], *full = centre_tape(wk, t, 0);
     interval *G = &wk->grad[pidx * 3];
     double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
     unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES];
