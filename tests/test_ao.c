@@ -17,6 +17,7 @@
 #include "render/ao.h"
 #include "render/frame.h"
 #include "render/shadow.h"
+#include "tests/grid_hits.h"
 #include "tests/voxel_shapes.h"
 
 #define LEVELS 6
@@ -190,20 +191,12 @@ static void test_shared_start_same_answers(void **state)
         for (int refine = 0; refine <= 1; refine++) {
             const trace_opts o = {.split = LEVELS, .refine = refine};
             trace_traverse_fn fn = trace_impls[impl].traverse;
-            for (int y = 0; y < 40; y++)
-                for (int x = 0; x < 40; x++) {
-                    const double target[3] = {18.0 + 1.13 * x, 18.0 + 1.07 * y, 21.3};
-                    double dir[3];
-                    for (int a = 0; a < 3; a++)
-                        dir[a] = target[a] - eye[a];
+            for (int y = 0; y < GRID_HITS_SIDE; y++)
+                for (int x = 0; x < GRID_HITS_SIDE; x++) {
                     trace_hit h;
-                    if (!trace_ray_cast(t, &o, eye, dir, &h))
-                        continue;
                     float n[3];
-                    oct_normal_decode(t->voxels[h.voxel] & OCT_VOXEL_NORMAL_MASK, n);
-                    if (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0.0)
-                        for (int a = 0; a < 3; a++)
-                            n[a] = -n[a];
+                    if (!grid_hit(t, &o, eye, x, y, &h, n))
+                        continue;
                     double org[3];
                     const int ok = shadow_origin(t, &h, n, org);
                     assert_int_equal(shadow_start_hit(t, &h, n, &st), ok);

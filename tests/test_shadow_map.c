@@ -13,9 +13,9 @@
 
 #include "bench/rng.h"
 #include "bench/tree_util.h"
-#include "format/oct_normal.h"
 #include "render/shadow.h"
 #include "render/shadow_map.h"
+#include "tests/grid_hits.h"
 #include "tests/voxel_shapes.h"
 
 /* The t range in which the ray g + t D meets the closed box [v, v + 1]^3,
@@ -135,20 +135,12 @@ static void test_stopped_rays_same_answers(void **state)
             const trace_traverse_fn fn = trace_impls[impl].traverse;
             shadow_start st;
             st.near = 0;
-            for (int y = 0; y < 40; y++)
-                for (int x = 0; x < 40; x++) {
-                    const double target[3] = {18.0 + 1.13 * x, 18.0 + 1.07 * y, 21.3};
-                    double dir[3];
-                    for (int a = 0; a < 3; a++)
-                        dir[a] = target[a] - eye[a];
+            for (int y = 0; y < GRID_HITS_SIDE; y++)
+                for (int x = 0; x < GRID_HITS_SIDE; x++) {
                     trace_hit h;
-                    if (!trace_ray_cast(t, &o, eye, dir, &h))
-                        continue;
                     float n[3];
-                    oct_normal_decode(t->voxels[h.voxel] & OCT_VOXEL_NORMAL_MASK, n);
-                    if (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0.0)
-                        for (int a = 0; a < 3; a++)
-                            n[a] = -n[a];
+                    if (!grid_hit(t, &o, eye, x, y, &h, n))
+                        continue;
                     if (!shadow_start_hit(t, &h, n, &st))
                         continue;
                     for (unsigned l = 0; l < NL; l++) {
@@ -173,11 +165,41 @@ static void test_stopped_rays_same_answers(void **state)
     tree_util_free(t);
 }
 
+/* grid_hit: the hits are those of the ray to each target, the normals face
+ * the eye, and a ray that misses reports no hit. */
+static void test_grid_hit_faces_eye(void **state)
+{
+    (void)state;
+    enum { LEVELS = 6 };
+    const shape sh[1] = {shape_plane(0, 0, 1, 21.0)};
+    oct_tree *t = shapes_build(LEVELS, 64.0, sh, 1, 1);
+    assert_non_null(t);
+    const trace_opts o = {.split = LEVELS};
+    const double eye[3] = {150, 110, 120}, away[3] = {150, 110, -120};
+    unsigned hits = 0;
+    for (int y = 0; y < GRID_HITS_SIDE; y++)
+        for (int x = 0; x < GRID_HITS_SIDE; x++) {
+            trace_hit h;
+            float n[3];
+            if (!grid_hit(t, &o, eye, x, y, &h, n))
+                continue;
+            hits++;
+            assert_true(n[2] > 0.5f); /* the plane's normal, toward the eye above it */
+            trace_hit g;
+            float m[3];
+            assert_int_equal(grid_hit(t, &o, away, x, y, &g, m), 1);
+            assert_true(m[2] < -0.5f); /* the same plane seen from below */
+        }
+    assert_int_equal(hits, GRID_HITS_SIDE * GRID_HITS_SIDE);
+    tree_util_free(t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_clear_t_bounds_every_voxel),
         cmocka_unit_test(test_stopped_rays_same_answers),
+        cmocka_unit_test(test_grid_hit_faces_eye),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
