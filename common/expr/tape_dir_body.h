@@ -4,6 +4,7 @@
  * d[N]). seed[k] is the tangent of coordinate k; every tangent follows the
  * same operations, so one tangent seeded with a direction is, bit for bit,
  * the same whatever the others are. */
+#define OP TAPE_OPL
 #define TANGENTS for (unsigned j = 0; j < N; j++)
 
 static inline double FN(const tape *t, const double p[3], const double seed[3][N], SLOT *s)
@@ -15,111 +16,111 @@ static inline double FN(const tape *t, const double p[3], const double seed[3][N
         /* operands: only the ops that have them name them (as tape_eval) */
 #define OA s[in[i].a]
 #define OC s[in[i].b]
-        switch ((tape_op)in[i].op) {
-        case TAPE_CONST: r->v = k[in[i].a].v; TANGENTS r->d[j] = 0.0; break;
-        case TAPE_X: case TAPE_Y: case TAPE_Z: {
+        TAPE_DISPATCH(in[i].op) {
+        OP(CONST): r->v = k[in[i].a].v; TANGENTS r->d[j] = 0.0; continue;
+        OP(X): OP(Y): OP(Z): {
             const uint32_t ax = in[i].op - TAPE_X;
             r->v = p[ax];
             TANGENTS r->d[j] = seed[ax][j];
-            break;
+            continue;
         }
-        case TAPE_NEG: r->v = -OA.v; TANGENTS r->d[j] = -OA.d[j]; break;
-        case TAPE_SQUARE: {
+        OP(NEG): r->v = -OA.v; TANGENTS r->d[j] = -OA.d[j]; continue;
+        OP(SQUARE): {
             const double a = OA.v, m = 2.0 * a;
             TANGENTS r->d[j] = OA.d[j] * m;
             r->v = a * a;
-            break;
+            continue;
         }
-        case TAPE_SQRT: {
+        OP(SQRT): {
             const double v = sqrt(OA.v), m = 0.5 / v;
             TANGENTS r->d[j] = OA.d[j] * m;
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_EXP: {
+        OP(EXP): {
             const double v = exp(OA.v);
             TANGENTS r->d[j] = OA.d[j] * v;
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_LOG: {
+        OP(LOG): {
             const double a = OA.v, m = 1.0 / a;
             TANGENTS r->d[j] = OA.d[j] * m;
             r->v = log(a);
-            break;
+            continue;
         }
-        case TAPE_ABS: {
+        OP(ABS): {
             const double a = OA.v;
             if (a < 0.0)
                 TANGENTS r->d[j] = -OA.d[j];
             else
                 TANGENTS r->d[j] = OA.d[j];
             r->v = fabs(a);
-            break;
+            continue;
         }
-        case TAPE_SIN: {
+        OP(SIN): {
             double sv, cv;
             point_sincos(OA.v, &sv, &cv);
             TANGENTS r->d[j] = OA.d[j] * cv;
             r->v = sv;
-            break;
+            continue;
         }
-        case TAPE_COS: {
+        OP(COS): {
             double sv, cv;
             point_sincos(OA.v, &sv, &cv);
             const double m = -sv;
             TANGENTS r->d[j] = OA.d[j] * m;
             r->v = cv;
-            break;
+            continue;
         }
-        case TAPE_TAN: {
+        OP(TAN): {
             const double v = tan(OA.v), m = 1.0 + v * v;
             TANGENTS r->d[j] = OA.d[j] * m;
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_ADD: {
+        OP(ADD): {
             const double v = OA.v + OC.v;
             TANGENTS r->d[j] = OA.d[j] + OC.d[j];
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_SUB: {
+        OP(SUB): {
             const double v = OA.v - OC.v;
             TANGENTS r->d[j] = OA.d[j] - OC.d[j];
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_MUL: {
+        OP(MUL): {
             const double a = OA.v, c = OC.v;
             TANGENTS r->d[j] = OA.d[j] * c + a * OC.d[j];
             r->v = a * c;
-            break;
+            continue;
         }
-        case TAPE_DIV: {
+        OP(DIV): {
             const double c = OC.v, v = OA.v / c;
             TANGENTS r->d[j] = (OA.d[j] - v * OC.d[j]) / c;
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_MIN:
-        case TAPE_MAX: {
+        OP(MIN):
+        OP(MAX): {
             const double a = OA.v;
             const double v = in[i].op == TAPE_MIN ? point_min(a, OC.v) : point_max(a, OC.v);
             const SLOT *w = (v == a || v != v) ? &OA : &OC;
             TANGENTS r->d[j] = w->d[j];
             r->v = v;
-            break;
+            continue;
         }
-        case TAPE_POWC: {
+        OP(POWC): {
             const double e = k[in[i].b].v, a = OA.v;
             const double m = e * pow(a, e - 1.0);
             TANGENTS r->d[j] = OA.d[j] * m;
             r->v = pow(a, e);
-            break;
+            continue;
         }
-        case TAPE_NOPS: r->v = NAN; TANGENTS r->d[j] = NAN; break;
-        default: TAPE_OP_NONE();
+        OP(NOPS): r->v = NAN; TANGENTS r->d[j] = NAN; continue;
+        TAPE_DISPATCH_DEFAULT();
         }
 #undef OA
 #undef OC
@@ -128,3 +129,4 @@ static inline double FN(const tape *t, const double p[3], const double seed[3][N
 }
 
 #undef TANGENTS
+#undef OP

@@ -66,6 +66,32 @@ static inline unsigned trig_memo_entry(trig_memo *m, uint32_t a, interval x, uns
 #define TAPE_OP_NONE() ((void)0)
 #endif
 
+/* The dispatch of a loop over a tape's instructions: OP(NAME) labels an
+ * op's code, which ends with continue. With GCC, a table of label addresses
+ * indexed by op code (one indirect jump from each op, not the switch's
+ * bounds test and shared jump); -DTAPE_NO_COMPUTED_GOTO or another compiler:
+ * the switch. */
+#if defined(__GNUC__) && !defined(TAPE_NO_COMPUTED_GOTO)
+#define TAPE_OPL(o) tape_l_##o
+#define TAPE_DISPATCH(op)                                                                      \
+    static const void *const tape_lbl_[] = {                                                   \
+        [TAPE_CONST] = &&tape_l_CONST, [TAPE_X] = &&tape_l_X,       [TAPE_Y] = &&tape_l_Y,     \
+        [TAPE_Z] = &&tape_l_Z,         [TAPE_NEG] = &&tape_l_NEG,   [TAPE_SQUARE] = &&tape_l_SQUARE, \
+        [TAPE_SQRT] = &&tape_l_SQRT,   [TAPE_EXP] = &&tape_l_EXP,   [TAPE_LOG] = &&tape_l_LOG, \
+        [TAPE_ABS] = &&tape_l_ABS,     [TAPE_SIN] = &&tape_l_SIN,   [TAPE_COS] = &&tape_l_COS, \
+        [TAPE_TAN] = &&tape_l_TAN,     [TAPE_ADD] = &&tape_l_ADD,   [TAPE_SUB] = &&tape_l_SUB, \
+        [TAPE_MUL] = &&tape_l_MUL,     [TAPE_DIV] = &&tape_l_DIV,   [TAPE_MIN] = &&tape_l_MIN, \
+        [TAPE_MAX] = &&tape_l_MAX,     [TAPE_POWC] = &&tape_l_POWC, [TAPE_NOPS] = &&tape_l_NOPS, \
+    };                                                                                         \
+    _Static_assert(sizeof tape_lbl_ / sizeof tape_lbl_[0] == TAPE_NOPS + 1, "one label an op"); \
+    goto *tape_lbl_[(op)];
+#define TAPE_DISPATCH_DEFAULT() ((void)0)
+#else
+#define TAPE_OPL(o) case TAPE_##o
+#define TAPE_DISPATCH(op) switch ((tape_op)(op))
+#define TAPE_DISPATCH_DEFAULT() default: TAPE_OP_NONE()
+#endif
+
 /* Operand slots of an instruction, 0 where the field is not a slot (a
  * constant-pool index, or unused), so that no pointer is formed outside
  * the caller's slot array. */
