@@ -11,20 +11,24 @@
  * live, EMPTY when dead, w when instruction i is replaced by instruction w (a
  * decided min/max), CONSTANT when it is replaced by its enclosure s[i] (an
  * interval narrower than `tiny`: see tape_prune_const). s may be NULL: then
- * only dead code goes. */
+ * only dead code goes. Returns how many instructions stay as they are (n:
+ * the tape is unchanged). */
 #define CONSTANT (EMPTY - 1)
-static void mark(const tape_insn *in, uint32_t n, uint32_t root, const interval *s, double tiny,
+static uint32_t mark(const tape_insn *in, uint32_t n, uint32_t root, const interval *s, double tiny,
                  uint32_t *m)
 {
     for (uint32_t i = 0; i < n; i++)
         m[i] = EMPTY;
     m[root] = root;
+    uint32_t kept = 0;
     for (uint32_t i = root + 1; i-- > 0;) {
         if (m[i] == EMPTY)
             continue;
         uint32_t op = in[i].op, a = in[i].a, c = in[i].b;
-        if (op == TAPE_CONST || op <= TAPE_Z)
+        if (op == TAPE_CONST || op <= TAPE_Z) {
+            kept++;
             continue;
+        }
         if (s && i != root && s[i].hi - s[i].lo <= tiny) { /* NaN or inf: the test fails */
             m[i] = CONSTANT;
             continue;
@@ -44,19 +48,25 @@ static void mark(const tape_insn *in, uint32_t n, uint32_t root, const interval 
                 continue;
             }
         }
+        kept++;
         if (m[a] == EMPTY)
             m[a] = a;
         if (op >= TAPE_ADD && op != TAPE_POWC && m[c] == EMPTY)
             m[c] = c;
     }
+    return kept;
 }
 
 /* Emits the live instructions renumbered; returns the count and sets *root.
  * An instruction marked CONSTANT becomes a constant whose enclosure is s[i],
  * appended to `konst` at *nconst. */
-static uint32_t compact(const tape_insn *in, uint32_t n, uint32_t *root, uint32_t *m, tape_insn *out,
-                        const interval *s, tape_const *konst, uint32_t *nconst)
+static uint32_t compact(const tape_insn *in, uint32_t n, uint32_t kept, uint32_t *root, uint32_t *m,
+                        tape_insn *out, const interval *s, tape_const *konst, uint32_t *nconst)
 {
+    if (kept == n) { /* nothing pruned: m is already the identity */
+        memcpy(out, in, n * sizeof *out);
+        return n;
+    }
     uint32_t k = 0;
     for (uint32_t i = 0; i < n; i++) {
         if (m[i] == EMPTY)
@@ -91,8 +101,8 @@ uint32_t tape_prune(const tape *t, const interval *slots, unsigned flags, tape_i
                     uint32_t *scratch, tape *out)
 {
     uint32_t root = t->root;
-    mark(t->insn, t->n, root, flags ? NULL : slots, -1.0, scratch);
-    uint32_t n = compact(t->insn, t->n, &root, scratch, out_insn, NULL, NULL, NULL);
+    uint32_t kept = mark(t->insn, t->n, root, flags ? NULL : slots, -1.0, scratch);
+    uint32_t n = compact(t->insn, t->n, kept, &root, scratch, out_insn, NULL, NULL, NULL);
     out->insn = out_insn;
     out->n = n;
     out->root = root;
@@ -106,9 +116,10 @@ uint32_t tape_prune_const(const tape *t, const interval *slots, unsigned flags, 
                           tape_insn *out_insn, tape_const *out_konst, uint32_t *scratch, tape *out)
 {
     uint32_t root = t->root, nconst = t->nconst;
-    mark(t->insn, t->n, root, flags ? NULL : slots, flags ? -1.0 : tiny, scratch);
+    uint32_t kept = mark(t->insn, t->n, root, flags ? NULL : slots, flags ? -1.0 : tiny, scratch);
     memcpy(out_konst, t->konst, t->nconst * sizeof *out_konst);
-    uint32_t n = compact(t->insn, t->n, &root, scratch, out_insn, slots, out_konst, &nconst);
+    uint32_t n =
+        compact(t->insn, t->n, kept, &root, scratch, out_insn, slots, out_konst, &nconst);
     out->insn = out_insn;
     out->n = n;
     out->root = root;
