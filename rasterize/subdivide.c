@@ -351,7 +351,7 @@ static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
 {
     const build_ctx *c = wk->c;
     const unsigned pidx = depth + 1;
-    const tape *t = &wk->tapes[pidx], *full = centre_tape(wk, t, 0);
+    const tape *t = &wk->tapes[pidx], *ct = centre_tape(wk, t, 0);
     interval *G = &wk->grad[pidx * 3];
     double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
     unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES];
@@ -375,7 +375,7 @@ static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
                 ch[n++] = i;
             }
             if (n == TAPE_LANES || (n && b + 1 == nb && i == 7)) {
-                centre_values(wk, full, n, x, y, z, f, g);
+                centre_values(wk, ct, n, x, y, z, f, g);
                 for (unsigned l = 0; l < n; l++) {
                     leaf_parent *q = &lp[owner[l]];
                     double *fg = q->cf8 + 4 * ch[l];

@@ -165,8 +165,8 @@ static void test_stopped_rays_same_answers(void **state)
     tree_util_free(t);
 }
 
-/* grid_hit: the hits are those of the ray to each target, the normals face
- * the eye, and a ray that misses reports no hit. */
+/* grid_hit: every ray to a grid target hits a plane under them, and the
+ * normal it gives faces the eye, from above and from below. */
 static void test_grid_hit_faces_eye(void **state)
 {
     (void)state;

@@ -129,9 +129,6 @@ interval interval_log(interval a, unsigned *flags)
     return mk(dn2(log(lo)), up2(log(a.hi)));
 }
 
-/* Beyond this magnitude trigonometric functions get their full range. */
-#define TRIG_MAX INTERVAL_TRIG_MAX
-
 /* May [lo, hi] contain phase + k*period for an integer k? Errs towards yes.
  * k = (x - phase) / period in double carries an absolute error below
  * ~2.2e-16 * (|x| + 2) / period (the subtraction) plus ~4.4e-16 * |k|
@@ -144,11 +141,6 @@ static int may_hit(double lo, double hi, double phase, double period)
     return floor(kh + eps) >= ceil(kl - eps);
 }
 
-static interval clamp11(double lo, double hi)
-{
-    return mk(lo < -1.0 ? -1.0 : lo, hi > 1.0 ? 1.0 : hi);
-}
-
 /* sin and cos share this: phase_max is where the function is 1. */
 static interval sin_or_cos(interval a, unsigned *flags, int is_cos)
 {
@@ -156,7 +148,7 @@ static interval sin_or_cos(interval a, unsigned *flags, int is_cos)
         return nan_iv(flags);
     if (isinf(a.lo) || isinf(a.hi))
         *flags |= INTERVAL_MAYBE_NAN; /* sin(inf) is NaN */
-    if (!(fabs(a.lo) <= TRIG_MAX && fabs(a.hi) <= TRIG_MAX) || a.hi - a.lo >= 6.0)
+    if (!(fabs(a.lo) <= INTERVAL_TRIG_MAX && fabs(a.hi) <= INTERVAL_TRIG_MAX) || a.hi - a.lo >= 6.0)
         return mk(-1.0, 1.0);
     double f0 = is_cos ? cos(a.lo) : sin(a.lo), f1 = is_cos ? cos(a.hi) : sin(a.hi);
     double lo = dn2(min2(f0, f1)), hi = up2(max2(f0, f1));
@@ -165,7 +157,7 @@ static interval sin_or_cos(interval a, unsigned *flags, int is_cos)
         hi = 1.0;
     if (may_hit(a.lo, a.hi, pmin, 2 * M_PI))
         lo = -1.0;
-    return clamp11(lo, hi);
+    return interval__clamp11(lo, hi);
 }
 
 interval interval_sin(interval a, unsigned *flags) { return sin_or_cos(a, flags, 0); }
@@ -211,7 +203,7 @@ interval interval_tan(interval a, unsigned *flags)
         return nan_iv(flags);
     if (isinf(a.lo) || isinf(a.hi))
         *flags |= INTERVAL_MAYBE_NAN;
-    if (!(fabs(a.lo) <= TRIG_MAX && fabs(a.hi) <= TRIG_MAX) || a.hi - a.lo >= 3.0 ||
+    if (!(fabs(a.lo) <= INTERVAL_TRIG_MAX && fabs(a.hi) <= INTERVAL_TRIG_MAX) || a.hi - a.lo >= 3.0 ||
         may_hit(a.lo, a.hi, M_PI / 2, M_PI))
         return mk(-INFINITY, INFINITY);
     return mk(dn2(tan(a.lo)), up2(tan(a.hi)));

@@ -147,6 +147,11 @@ static inline interval interval__nan_flag(unsigned *flags)
 #define INTERVAL_TRIG_MAX 1e8
 /* Covers every rounding of the narrow form (see interval_sincos). */
 #define INTERVAL_SINCOS_MARGIN 0x1p-48
+/* [lo, hi] with its ends limited to [-1, 1], the range of sin and cos. */
+static inline interval interval__clamp11(double lo, double hi)
+{
+    return interval__mk(lo < -1.0 ? -1.0 : lo, hi > 1.0 ? 1.0 : hi);
+}
 static inline int interval__sincos_narrow(interval a)
 {
     return a.hi - a.lo <= INTERVAL_TRIG_TAYLOR_WIDTH && fabs(a.lo) <= INTERVAL_TRIG_MAX &&
@@ -170,8 +175,7 @@ static inline interval interval__sincos_form(double v, double w, double h, doubl
     double t1 = fabs(w) * h;
     double sl = interval__max2(v - h - 0x1p-50, -1.0), sh = interval__min2(v + h + 0x1p-50, 1.0);
     double rl = interval__min2(0.0, -sh * q), rh = interval__max2(0.0, -sl * q);
-    double lo = v - t1 + rl - INTERVAL_SINCOS_MARGIN, hi = v + t1 + rh + INTERVAL_SINCOS_MARGIN;
-    return interval__mk(lo < -1.0 ? -1.0 : lo, hi > 1.0 ? 1.0 : hi);
+    return interval__clamp11(v - t1 + rl - INTERVAL_SINCOS_MARGIN, v + t1 + rh + INTERVAL_SINCOS_MARGIN);
 }
 
 /* True when i is the NaN interval. */
