@@ -165,8 +165,8 @@ static void test_stopped_rays_same_answers(void **state)
     tree_util_free(t);
 }
 
-/* grid_hit: every ray to a grid target hits a plane under them, and the
- * normal it gives faces the eye, from above and from below. */
+/* grid_hit: every ray from an eye above a plane to a grid target hits the
+ * plane with a normal facing the eye, and so does every ray from below. */
 static void test_grid_hit_faces_eye(void **state)
 {
     (void)state;

@@ -203,8 +203,8 @@ interval interval_tan(interval a, unsigned *flags)
         return nan_iv(flags);
     if (isinf(a.lo) || isinf(a.hi))
         *flags |= INTERVAL_MAYBE_NAN;
-    if (!(fabs(a.lo) <= INTERVAL_TRIG_MAX && fabs(a.hi) <= INTERVAL_TRIG_MAX) || a.hi - a.lo >= 3.0 ||
-        may_hit(a.lo, a.hi, M_PI / 2, M_PI))
+    if (!(fabs(a.lo) <= INTERVAL_TRIG_MAX && fabs(a.hi) <= INTERVAL_TRIG_MAX) ||
+        a.hi - a.lo >= 3.0 || may_hit(a.lo, a.hi, M_PI / 2, M_PI))
         return mk(-INFINITY, INFINITY);
     return mk(dn2(tan(a.lo)), up2(tan(a.hi)));
 }

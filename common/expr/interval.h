@@ -175,7 +175,8 @@ static inline interval interval__sincos_form(double v, double w, double h, doubl
     double t1 = fabs(w) * h;
     double sl = interval__max2(v - h - 0x1p-50, -1.0), sh = interval__min2(v + h + 0x1p-50, 1.0);
     double rl = interval__min2(0.0, -sh * q), rh = interval__max2(0.0, -sl * q);
-    return interval__clamp11(v - t1 + rl - INTERVAL_SINCOS_MARGIN, v + t1 + rh + INTERVAL_SINCOS_MARGIN);
+    return interval__clamp11(v - t1 + rl - INTERVAL_SINCOS_MARGIN,
+                             v + t1 + rh + INTERVAL_SINCOS_MARGIN);
 }
 
 /* True when i is the NaN interval. */
