@@ -500,10 +500,10 @@ int frame_render(const frame_job *job, frame_stats *stats)
     int rc = 0;
     shadow_map smap;
     if (job->shade.shadows) {
-        /* made on this thread before the passes: its time is the shadow
-           rays', as if every thread waited for it */
+        /* made before the passes on all the threads: its time is the
+           shadow rays' */
         const double t0 = job->timing ? frame_now_ns() : 0.0;
-        if (shadow_map_build(job->tree, job->shade.light, &smap) == 0)
+        if (shadow_map_build(job->tree, job->shade.light, job->threads, &smap) == 0)
             sh.shadow_map = &smap;
         if (job->timing)
             sy.sum.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);

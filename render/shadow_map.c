@@ -2,78 +2,198 @@
 #include "render/shadow_map.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "render/basis.h"
 
 /* The map's cells are no deeper than this: under 900 texels a side
  * (a 2^9 grid's projection) whatever the levels. */
 #define SHADOW_MAP_MAX_DEPTH 9
+/* The depth of the subtrees the threads take one at a time (at most 512). */
+#define SPLIT_DEPTH 3
 
 static double dot3(const double a[3], const double b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/* A node and its corner's projections (. u, . v, . w), grid units. */
+typedef struct map_node {
+    uint64_t index;
+    double p[3];
+} map_node;
+
 /* What the walk over the cells reads. */
 typedef struct build_ctx {
     const oct_tree *tree;
-    shadow_map *m;
-    unsigned depth;     /* of the map's cells */
-    double side;        /* their side, grid units */
-    double lo[2], hi[2]; /* a cell's projected corners: corner . u (v) + these */
-    double top;         /* its greatest height: corner . w + this */
+    const shadow_map *m;
+    unsigned depth;           /* of the map's cells */
+    double lo[2], hi[2];      /* a cell's texel range: (corner . u (v) + these) / texel */
+    double top;               /* its greatest height: corner . w + this */
+    double child[SHADOW_MAP_MAX_DEPTH][8][3]; /* child k's corner offset at depth d + 1,
+                                                 projected: the corner's, summed on the way
+                                                 down (one rounding a level, far under
+                                                 the margin) */
+    map_node *split;          /* the nodes of depth min(SPLIT_DEPTH, depth) */
+    size_t nsplit;
+    atomic_size_t next;       /* the next of them to take */
 } build_ctx;
 
-/* floor(x) clamped to [0, n - 1] (x >= 0 but for the margin). */
+/* floor(x) clamped to [0, n - 1] (x >= 0 but for the margin); branch-free
+ * (a NaN gives 0). */
 static uint32_t texel(double x, uint32_t n)
 {
-    if (!(x >= 0.0))
-        return 0;
-    if (x >= (double)(n - 1u))
-        return n - 1u;
-    return (uint32_t)x;
+    const double top = (double)(n - 1u);
+    x = x > 0.0 ? x : 0.0;
+    return (uint32_t)(x < top ? x : top);
 }
 
-static void put_cell(const build_ctx *c, const double corner[3])
+/* x (finite or -inf) as a float no smaller than x. */
+static float float_up(double x)
 {
-    shadow_map *m = c->m;
-    const double pu = dot3(corner, m->u), pv = dot3(corner, m->v);
-    const double f = dot3(corner, m->w) + c->top;
-    const uint32_t i0 = texel((pu + c->lo[0] - m->u0) * m->inv_texel, m->nu);
-    const uint32_t i1 = texel((pu + c->hi[0] - m->u0) * m->inv_texel, m->nu);
-    const uint32_t j0 = texel((pv + c->lo[1] - m->v0) * m->inv_texel, m->nv);
-    const uint32_t j1 = texel((pv + c->hi[1] - m->v0) * m->inv_texel, m->nv);
-    for (uint32_t j = j0; j <= j1; j++)
-        for (uint32_t i = i0; i <= i1; i++) {
-            double *p = &m->top[(size_t)j * m->nu + i];
-            if (*p < f)
-                *p = f;
-        }
+    float f = (float)x;
+    if ((double)f < x) { /* rounded down: one step up, by its bits */
+        uint32_t b;
+        memcpy(&b, &f, sizeof b);
+        if (f > 0.0f)
+            b++;
+        else if (f < 0.0f)
+            b--;
+        else
+            b = 1u; /* the least subnormal */
+        memcpy(&f, &b, sizeof f);
+    }
+    return f;
 }
 
-/* Node `node` of depth d with corner (x, y, z) in voxels: its cells of the
- * map's depth put into the map. */
-static void put_node(const build_ctx *c, unsigned d, uint64_t node, const uint32_t corner[3])
+static void put_cell(const build_ctx *c, float *top, const double p[3])
+{
+    const shadow_map *m = c->m;
+    const float f = float_up(p[2] + c->top);
+    const double su = p[0] * m->inv_texel, sv = p[1] * m->inv_texel;
+    const uint32_t i0 = texel(su + c->lo[0], m->nu), i1 = texel(su + c->hi[0], m->nu);
+    const uint32_t j0 = texel(sv + c->lo[1], m->nv), j1 = texel(sv + c->hi[1], m->nv);
+    for (uint32_t j = j0; j <= j1; j++) {
+        float *row = &top[(size_t)j * m->nu];
+        for (uint32_t i = i0; i <= i1; i++)
+            row[i] = f > row[i] ? f : row[i]; /* maxss: no branch to mispredict */
+    }
+}
+
+/* Node n of depth d: its cells of the map's depth put into top. */
+static void put_node(const build_ctx *c, float *top, unsigned d, const map_node *n)
 {
     if (d == c->depth) {
-        const double g[3] = {corner[0], corner[1], corner[2]};
-        put_cell(c, g);
+        put_cell(c, top, n->p);
         return;
     }
-    const oct_children ch = oct_node_children(c->tree->groups[d], node);
-    const uint32_t half = UINT32_C(1) << (c->tree->levels - d - 1u);
-    uint64_t k = ch.first;
+    const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
+    map_node k;
+    k.index = ch.first;
     for (unsigned i = 0; i < 8; i++) {
         if (!(ch.mask >> i & 1u))
             continue;
-        const uint32_t cc[3] = {corner[0] + (i & 1u) * half, corner[1] + (i >> 1 & 1u) * half,
-                                corner[2] + (i >> 2 & 1u) * half};
-        put_node(c, d + 1u, k++, cc);
+        for (int a = 0; a < 3; a++)
+            k.p[a] = n->p[a] + c->child[d][i][a];
+        put_node(c, top, d + 1u, &k);
+        k.index++;
     }
 }
 
-int shadow_map_build(const oct_tree *tree, const double light[3], shadow_map *m)
+/* The nodes of depth `stop` under n (of depth d), in order, into c->split. */
+static void collect(build_ctx *c, unsigned d, unsigned stop, const map_node *n)
+{
+    if (d == stop) {
+        c->split[c->nsplit++] = *n;
+        return;
+    }
+    const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
+    map_node k;
+    k.index = ch.first;
+    for (unsigned i = 0; i < 8; i++) {
+        if (!(ch.mask >> i & 1u))
+            continue;
+        for (int a = 0; a < 3; a++)
+            k.p[a] = n->p[a] + c->child[d][i][a];
+        collect(c, d + 1u, stop, &k);
+        k.index++;
+    }
+}
+
+typedef struct build_worker {
+    build_ctx *c;
+    float *top;
+} build_worker;
+
+static void *build_run(void *arg)
+{
+    const build_worker *w = arg;
+    build_ctx *c = w->c;
+    const unsigned d = c->depth < SPLIT_DEPTH ? c->depth : SPLIT_DEPTH;
+    for (;;) {
+        const size_t k = atomic_fetch_add(&c->next, 1);
+        if (k >= c->nsplit)
+            return NULL;
+        put_node(c, w->top, d, &c->split[k]);
+    }
+}
+
+static float *empty_map(size_t texels)
+{
+    float *t = malloc(texels * sizeof *t);
+    for (size_t k = 0; t && k < texels; k++)
+        t[k] = -INFINITY;
+    return t;
+}
+
+/* The cells put into m->top by up to `threads` threads. */
+static int put_cells(build_ctx *c, unsigned threads)
+{
+    const shadow_map *m = c->m;
+    const size_t texels = (size_t)m->nu * m->nv;
+    const unsigned d = c->depth < SPLIT_DEPTH ? c->depth : SPLIT_DEPTH;
+    c->split = malloc(((size_t)1 << (3 * d)) * sizeof *c->split);
+    if (!c->split)
+        return -1;
+    c->nsplit = 0;
+    const map_node root = {0, {0.0, 0.0, 0.0}};
+    collect(c, 0, d, &root);
+    atomic_init(&c->next, 0);
+    if (threads > 8)
+        threads = 8;
+    if ((size_t)threads > c->nsplit)
+        threads = c->nsplit ? (unsigned)c->nsplit : 1u;
+    build_worker w[8];
+    pthread_t tid[8];
+    unsigned started = 1;
+    w[0] = (build_worker){c, m->top};
+    for (; started < threads; started++) {
+        w[started] = (build_worker){c, empty_map(texels)};
+        if (!w[started].top)
+            break;
+        if (pthread_create(&tid[started], NULL, build_run, &w[started]) != 0) {
+            free(w[started].top);
+            break; /* the started threads and this one do the rest */
+        }
+    }
+    build_run(&w[0]);
+    for (unsigned t = 1; t < started; t++) {
+        pthread_join(tid[t], NULL);
+        const float *src = w[t].top;
+        for (size_t k = 0; k < texels; k++)
+            if (m->top[k] < src[k])
+                m->top[k] = src[k];
+        free(w[t].top);
+    }
+    free(c->split);
+    return 0;
+}
+
+int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threads,
+                     shadow_map *m)
 {
     for (int a = 0; a < 3; a++)
         m->light[a] = light[a];
@@ -90,7 +210,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], shadow_map *m)
     c.depth = levels > SHADOW_MAP_UP ? levels - SHADOW_MAP_UP : 0;
     if (c.depth > SHADOW_MAP_MAX_DEPTH)
         c.depth = SHADOW_MAP_MAX_DEPTH;
-    c.side = (double)(UINT32_C(1) << (levels - c.depth));
+    const double side = (double)(UINT32_C(1) << (levels - c.depth));
     const double n = (double)(UINT32_C(1) << levels);
     /* the cube's projection, one grid unit wider on each side than its
        corners' (every grown cell lies inside) */
@@ -105,30 +225,42 @@ int shadow_map_build(const oct_tree *tree, const double light[3], shadow_map *m)
     }
     m->u0 = ulo - 1.0;
     m->v0 = vlo - 1.0;
-    m->inv_texel = 1.0 / c.side;
+    m->inv_texel = 1.0 / side;
     m->nu = (uint32_t)((uhi + 1.0 - m->u0) * m->inv_texel) + 1u;
     m->nv = (uint32_t)((vhi + 1.0 - m->v0) * m->inv_texel) + 1u;
-    m->top = malloc((size_t)m->nu * m->nv * sizeof *m->top);
+    m->top = empty_map((size_t)m->nu * m->nv);
     if (!m->top)
         return -1;
-    for (size_t k = 0; k < (size_t)m->nu * m->nv; k++)
-        m->top[k] = -INFINITY;
-    /* a cell's extremes over its corners, grown by the margin */
+    /* a cell's extremes over its corners, grown by the margin, in texels
+       from the plane's origin (the texel side is a power of two: exact) */
     for (int p = 0; p < 2; p++) {
         const double *ax = p ? m->v : m->u;
-        c.lo[p] = -SHADOW_MAP_MARGIN;
-        c.hi[p] = SHADOW_MAP_MARGIN;
+        double lo = -SHADOW_MAP_MARGIN, hi = SHADOW_MAP_MARGIN;
         for (int a = 0; a < 3; a++) {
-            c.lo[p] += fmin(0.0, ax[a] * c.side);
-            c.hi[p] += fmax(0.0, ax[a] * c.side);
+            lo += fmin(0.0, ax[a] * side);
+            hi += fmax(0.0, ax[a] * side);
         }
+        const double o = p ? m->v0 : m->u0;
+        c.lo[p] = (lo - o) * m->inv_texel;
+        c.hi[p] = (hi - o) * m->inv_texel;
     }
     c.top = SHADOW_MAP_MARGIN;
     for (int a = 0; a < 3; a++)
-        c.top += fmax(0.0, w[a] * c.side);
-    if (tree->node_count[0]) {
-        const uint32_t origin[3] = {0, 0, 0};
-        put_node(&c, 0, 0, origin);
+        c.top += fmax(0.0, w[a] * side);
+    const double *axes[3] = {m->u, m->v, m->w};
+    for (unsigned d = 0; d < c.depth; d++) {
+        const double half = (double)(UINT32_C(1) << (levels - d - 1u));
+        for (unsigned k = 0; k < 8; k++)
+            for (int p = 0; p < 3; p++) {
+                const double *ax = axes[p];
+                c.child[d][k][p] = (double)(k & 1u) * half * ax[0] +
+                                   (double)(k >> 1 & 1u) * half * ax[1] +
+                                   (double)(k >> 2 & 1u) * half * ax[2];
+            }
+    }
+    if (tree->node_count[0] && put_cells(&c, threads ? threads : 1u) != 0) {
+        shadow_map_free(m);
+        return -1;
     }
     return 0;
 }
@@ -149,8 +281,8 @@ double shadow_map_clear_t(const shadow_map *m, const double g[3], const double l
     const double y = (dot3(g, m->v) - m->v0) * m->inv_texel;
     if (!(x >= 0.0 && y >= 0.0 && x < (double)m->nu && y < (double)m->nv))
         return x == x && y == y ? -INFINITY : INFINITY; /* beside every cell; NaN: unknown */
-    const double top = m->top[(size_t)(uint32_t)y * m->nu + (uint32_t)x];
+    const double top = (double)m->top[(size_t)(uint32_t)y * m->nu + (uint32_t)x];
     if (top == -INFINITY)
         return -INFINITY;
-    return ((double)top - dot3(g, m->w)) / (scale * dot3(light, m->w));
+    return (top - dot3(g, m->w)) / (scale * dot3(light, m->w));
 }

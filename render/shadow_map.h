@@ -24,13 +24,16 @@ typedef struct shadow_map {
     double u0, v0;          /* the plane's origin: the cube's projections start there */
     double inv_texel;       /* 1 / texel side, grid units */
     uint32_t nu, nv;
-    double *top;            /* nu * nv greatest heights, -inf: none */
+    float *top;             /* nu * nv greatest heights rounded up, -inf: none */
 } shadow_map;
 
 /* Makes m for tree and the unit-or-not light direction `light` (finite,
- * non-zero). Returns 0, or -1 when the memory cannot be had (m->top NULL:
- * then shadow_map_clear_t gives +inf). Free with shadow_map_free. */
-int shadow_map_build(const oct_tree *tree, const double light[3], shadow_map *m);
+ * non-zero) on up to `threads` threads (the same map whatever their number:
+ * each takes whole subtrees into a map of its own, the maps are merged by
+ * their maximum). Returns 0, or -1 when the memory cannot be had (m->top
+ * NULL: then shadow_map_clear_t gives +inf). Free with shadow_map_free. */
+int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threads,
+                     shadow_map *m);
 void shadow_map_free(shadow_map *m); /* accepts a failed build */
 
 /* For the ray g + t (scale * light), g a grid point and scale the tree's

@@ -66,7 +66,7 @@ static void test_clear_t_bounds_every_voxel(void **state)
             const double scale = (double)n / t->edge;
             for (size_t l = 0; l < sizeof lights / sizeof lights[0]; l++) {
                 shadow_map m;
-                assert_int_equal(shadow_map_build(t, lights[l], &m), 0);
+                assert_int_equal(shadow_map_build(t, lights[l], 1, &m), 0);
                 const double D[3] = {scale * lights[l][0], scale * lights[l][1],
                                      scale * lights[l][2]};
                 for (int k = 0; k < 400; k++) {
@@ -109,6 +109,38 @@ static void test_clear_t_bounds_every_voxel(void **state)
     assert_true(met > 2000 && none > 1000);
 }
 
+/* The map is the same whatever the number of threads that build it (each
+ * takes whole subtrees into a map of its own, merged by the maximum): bit
+ * for bit, on a random tree of 7 levels with more subtrees than threads. */
+static void test_same_map_any_threads(void **state)
+{
+    (void)state;
+    enum { LEVELS = 7 };
+    const uint32_t n = UINT32_C(1) << LEVELS;
+    uint64_t rng = 0x7ea45u;
+    static uint32_t xyz[3000][3];
+    const size_t nv = tree_util_distinct_voxels(3000, 0, n, &rng, xyz);
+    oct_tree *t = tree_util_simple(LEVELS, (const uint32_t(*)[3])xyz, nv);
+    assert_non_null(t);
+    const double light[3] = {-0.3, 0.45, 0.84};
+    shadow_map one;
+    assert_int_equal(shadow_map_build(t, light, 1, &one), 0);
+    size_t raised = 0;
+    for (size_t k = 0; k < (size_t)one.nu * one.nv; k++)
+        raised += one.top[k] > -INFINITY;
+    assert_true(raised > (size_t)one.nu * one.nv / 4);
+    for (unsigned threads = 2; threads <= 9; threads += 7) {
+        shadow_map m;
+        assert_int_equal(shadow_map_build(t, light, threads, &m), 0);
+        assert_int_equal(m.nu, one.nu);
+        assert_int_equal(m.nv, one.nv);
+        assert_memory_equal(m.top, one.top, (size_t)one.nu * one.nv * sizeof *one.top);
+        shadow_map_free(&m);
+    }
+    shadow_map_free(&one);
+    tree_util_free(t);
+}
+
 /* Shadow rays from the hits of a view, stopped where the map says: the
  * answers of the rays traced whole, never more steps. */
 static void test_stopped_rays_same_answers(void **state)
@@ -127,7 +159,7 @@ static void test_stopped_rays_same_answers(void **state)
     enum { NL = sizeof lights / sizeof lights[0] };
     shadow_map maps[NL];
     for (unsigned l = 0; l < NL; l++)
-        assert_int_equal(shadow_map_build(t, lights[l], &maps[l]), 0);
+        assert_int_equal(shadow_map_build(t, lights[l], 2, &maps[l]), 0);
     unsigned long rays = 0, blocked = 0, fewer = 0;
     for (unsigned impl = 0; impl < trace_impl_count; impl++)
         for (int refine = 0; refine <= 1; refine++) {
@@ -198,6 +230,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_clear_t_bounds_every_voxel),
+        cmocka_unit_test(test_same_map_any_threads),
         cmocka_unit_test(test_stopped_rays_same_answers),
         cmocka_unit_test(test_grid_hit_faces_eye),
     };
