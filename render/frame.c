@@ -10,6 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#endif
 
 #include "common/test_hooks.h"
 #include "common/view/image.h"
@@ -26,6 +29,7 @@ typedef struct frame_sync {
     pthread_mutex_t lock; /* guards the sums below */
     frame_acc sum;
     double pass_ns; /* thread time of the passes, secondary rays left out */
+    double shadow_ns, ao_ns, sample_ns; /* the threads' frame_acc ticks, in ns */
     exact_worker *exact; /* with --exact: one per thread of a pass, else NULL */
     atomic_uint next_exact;
 } frame_sync;
@@ -37,6 +41,18 @@ double frame_now_ns(void)
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
+
+#if defined(__x86_64__) || defined(__i386__)
+double frame_ticks(void)
+{
+    return (double)__rdtsc();
+}
+#else
+double frame_ticks(void)
+{
+    return frame_now_ns();
+}
+#endif
 
 /* image_srgb8 without pow: the code value is the number of thresholds at or
  * below the input, where threshold k is the least float whose image_srgb8
@@ -117,7 +133,7 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
     if (h->hit && (shadow || ao_count)) {
         /* timed per kind: the shared start goes to the shadow ray when
            there is one */
-        const double t0 = job->timing ? frame_now_ns() : 0.0;
+        const double t0 = job->timing ? frame_ticks() : 0.0;
         double t1 = t0;
         double p[3];
         for (int a = 0; a < 3; a++)
@@ -132,7 +148,7 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
                                     job->shade.light, INFINITY, &acc->secondary_steps))
                 lam = 0.0;
             if (job->timing)
-                t1 = frame_now_ns();
+                t1 = frame_ticks();
         }
         if (ao_count) {
             ao = ao_factor_from(job->tree, &job->opts, sh->traverse, st, n, ao_k0, ao_count,
@@ -141,14 +157,15 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
         }
     lit:
         if (job->timing) {
-            const double t2 = frame_now_ns();
+            /* no AO rays: the shadow ray's end is the end */
+            const double t2 = ao_count || t1 == t0 ? frame_ticks() : t1;
             if (shadow) {
                 if (t1 == t0) /* no start: all of it the shadow's */
                     t1 = t2;
-                acc->shadow_ns += t1 - t0;
-                acc->ao_ns += t2 - t1;
+                acc->shadow_tk += t1 - t0;
+                acc->ao_tk += t2 - t1;
             } else {
-                acc->ao_ns += t2 - t0;
+                acc->ao_tk += t2 - t0;
             }
         }
     }
@@ -365,6 +382,7 @@ static void work(const frame_shared *common, int caller)
     frame_acc acc;
     memset(&acc, 0, sizeof acc);
     const double t0 = sh->job->timing ? frame_now_ns() : 0.0;
+    const double k0 = sh->job->timing ? frame_ticks() : 0.0;
     for (;;) {
         if (atomic_load_explicit(&sy->changed, memory_order_relaxed))
             break; /* another thread met the file changing: stop */
@@ -379,6 +397,9 @@ static void work(const frame_shared *common, int caller)
             test_hooks_tile(d);
     }
     const double ns = sh->job->timing ? frame_now_ns() - t0 : 0.0;
+    const double ticks = sh->job->timing ? frame_ticks() - k0 : 0.0;
+    const double ns_per_tick = ticks > 0.0 ? ns / ticks : 0.0;
+    const double shadow_ns = acc.shadow_tk * ns_per_tick, ao_ns = acc.ao_tk * ns_per_tick;
     pthread_mutex_lock(&sy->lock);
     sy->sum.rays += acc.rays;
     sy->sum.hits += acc.hits;
@@ -388,10 +409,10 @@ static void work(const frame_shared *common, int caller)
     sy->sum.shadow_rays += acc.shadow_rays;
     sy->sum.ao_rays += acc.ao_rays;
     sy->sum.secondary_steps += acc.secondary_steps;
-    sy->sum.shadow_ns += acc.shadow_ns;
-    sy->sum.ao_ns += acc.ao_ns;
-    sy->sum.sample_ns += acc.sample_ns;
-    sy->pass_ns += ns - acc.shadow_ns - acc.ao_ns;
+    sy->shadow_ns += shadow_ns;
+    sy->ao_ns += ao_ns;
+    sy->sample_ns += acc.sample_tk * ns_per_tick;
+    sy->pass_ns += ns - shadow_ns - ao_ns;
     pthread_mutex_unlock(&sy->lock);
 }
 
@@ -506,7 +527,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
         if (shadow_map_build(job->tree, job->shade.light, job->threads, &smap) == 0)
             sh.shadow_map = &smap;
         if (job->timing)
-            sy.sum.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
+            sy.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
     }
     if (job->aa > 1) {
         sh.border = frame_border_alloc(ntiles);
@@ -539,11 +560,11 @@ int frame_render(const frame_job *job, frame_stats *stats)
     stats->shadow_rays = sy.sum.shadow_rays;
     stats->ao_rays = sy.sum.ao_rays;
     stats->secondary_steps = sy.sum.secondary_steps;
-    stats->shadow_ns = sy.sum.shadow_ns;
-    stats->ao_ns = sy.sum.ao_ns;
-    stats->secondary_ns = sy.sum.shadow_ns + sy.sum.ao_ns;
-    stats->centre_ns = sy.pass_ns - sy.sum.sample_ns;
-    stats->sample_ns = sy.sum.sample_ns;
+    stats->shadow_ns = sy.shadow_ns;
+    stats->ao_ns = sy.ao_ns;
+    stats->secondary_ns = sy.shadow_ns + sy.ao_ns;
+    stats->centre_ns = sy.pass_ns - sy.sample_ns;
+    stats->sample_ns = sy.sample_ns;
     stats->primary_ns = sy.pass_ns;
     stats->samples = sy.sum.rays;
     stats->file_changed = atomic_load(&sy.changed);

@@ -13,8 +13,9 @@
 typedef struct frame_acc {
     uint64_t rays, hits, steps, aa_pixels, aa_full, shadow_rays, ao_rays, secondary_steps;
     uint64_t marked; /* sub-blocks marked by the beam's edge trigger */
-    double shadow_ns, ao_ns;
-    double sample_ns; /* with timing: in the antialiasing samples, their secondary rays' left out */
+    /* with timing, in frame_ticks' ticks: the secondary rays' time, and the
+       antialiasing samples' less their secondary rays' */
+    double shadow_tk, ao_tk, sample_tk;
     shadow_start start; /* the last hit's secondary start: its anchor is the
                            next one's search hint (start.near) */
 } frame_acc;
@@ -49,6 +50,13 @@ typedef struct frame_shared {
 
 /* CLOCK_MONOTONIC in nanoseconds. */
 double frame_now_ns(void);
+
+/* A clock for the short intervals timed per hit and per sample: the CPU's
+ * time-stamp counter where there is one (a third of clock_gettime's cost
+ * here, which would otherwise be a tenth of a shadow ray's time), else
+ * frame_now_ns. Its ticks become nanoseconds by the rate measured over a
+ * thread's pass (frame.c's work). */
+double frame_ticks(void);
 
 /* frame_srgb8 once a frame_render has set its tables up. */
 uint8_t frame_srgb8_ready(float x);

@@ -241,18 +241,18 @@ static aa_probe *border_of(const frame_shared *sh, uint32_t tx, uint32_t ty)
     return sh->border + ((size_t)ty * sh->tiles_x + tx) * FRAME_BORDER;
 }
 
-/* Adds the thread time since t0 to the samples', less the secondary rays'
- * time since their sum was sec0. */
+/* Adds the thread time since t0 (ticks) to the samples', less the
+ * secondary rays' time since their sum was sec0. */
 static void sample_time(const frame_shared *sh, frame_acc *acc, double t0, double sec0)
 {
     if (sh->job->timing)
-        acc->sample_ns += frame_now_ns() - t0 - (acc->shadow_ns + acc->ao_ns - sec0);
+        acc->sample_tk += frame_ticks() - t0 - (acc->shadow_tk + acc->ao_tk - sec0);
 }
 
 void frame_aa_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, int any,
                    uint32_t tx, uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
 {
-    const double t0 = sh->job->timing ? frame_now_ns() : 0.0, sec0 = acc->shadow_ns + acc->ao_ns;
+    const double t0 = sh->job->timing ? frame_ticks() : 0.0, sec0 = acc->shadow_tk + acc->ao_tk;
     aa_probe *const tp = sh->tile->p;
     const uint32_t w = i1 - i0, h = j1 - j0;
     if (any) {
@@ -290,7 +290,7 @@ void frame_aa_tile(const frame_shared *sh, frame_acc *acc, const trace_eye *eye,
 void frame_aa_border(const frame_shared *sh, frame_acc *acc, const trace_eye *eye, uint32_t tx,
                      uint32_t ty, uint32_t i0, uint32_t i1, uint32_t j0, uint32_t j1)
 {
-    const double t0 = sh->job->timing ? frame_now_ns() : 0.0, sec0 = acc->shadow_ns + acc->ao_ns;
+    const double t0 = sh->job->timing ? frame_ticks() : 0.0, sec0 = acc->shadow_tk + acc->ao_tk;
     const camera *cam = sh->job->cam;
     const aa_probe *b = border_of(sh, tx, ty);
     /* the facing sides of the four neighbouring tiles, where there are and
