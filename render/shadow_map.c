@@ -31,9 +31,12 @@ typedef struct build_ctx {
     const oct_tree *tree;
     const shadow_map *m;
     unsigned depth;           /* of the map's cells */
-    double lo[2], hi[2];      /* a cell's texel range: (corner . u (v) + these) / texel */
-    double top;               /* its greatest height: corner . w + this */
-    double child[SHADOW_MAP_MAX_DEPTH][8][3]; /* child k's corner offset at depth d + 1,
+    struct {
+        double lo[2], hi[2];  /* a cell's texel range: corner . u (v) / texel + these */
+        double top;           /* its greatest height: corner . w + this */
+    } box[256];               /* by the cell's mask of children: the boxes of its
+                                 occupied children, grown by the margin */
+    double child[SHADOW_MAP_MAX_DEPTH + 1][8][3]; /* child k's corner offset at depth d + 1,
                                                  projected: the corner's, summed on the way
                                                  down (one rounding a level, far under
                                                  the margin) */
@@ -69,13 +72,14 @@ static float float_up(double x)
     return f;
 }
 
-static void put_cell(const build_ctx *c, float *top, const double p[3])
+static void put_cell(const build_ctx *c, float *top, const double p[3], unsigned mask)
 {
     const shadow_map *m = c->m;
-    const float f = float_up(p[2] + c->top);
+    const float f = float_up(p[2] + c->box[mask].top);
     const double su = p[0] * m->inv_texel, sv = p[1] * m->inv_texel;
-    const uint32_t i0 = texel(su + c->lo[0], m->nu), i1 = texel(su + c->hi[0], m->nu);
-    const uint32_t j0 = texel(sv + c->lo[1], m->nv), j1 = texel(sv + c->hi[1], m->nv);
+    const double *lo = c->box[mask].lo, *hi = c->box[mask].hi;
+    const uint32_t i0 = texel(su + lo[0], m->nu), i1 = texel(su + hi[0], m->nu);
+    const uint32_t j0 = texel(sv + lo[1], m->nv), j1 = texel(sv + hi[1], m->nv);
     for (uint32_t j = j0; j <= j1; j++) {
         float *row = &top[(size_t)j * m->nu];
         for (uint32_t i = i0; i <= i1; i++)
@@ -86,11 +90,11 @@ static void put_cell(const build_ctx *c, float *top, const double p[3])
 /* Node n of depth d: its cells of the map's depth put into top. */
 static void put_node(const build_ctx *c, float *top, unsigned d, const map_node *n)
 {
+    const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
     if (d == c->depth) {
-        put_cell(c, top, n->p);
+        put_cell(c, top, n->p, ch.mask);
         return;
     }
-    const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
     map_node k;
     k.index = ch.first;
     for (unsigned i = 0; i < 8; i++) {
@@ -231,24 +235,8 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
     m->top = empty_map((size_t)m->nu * m->nv);
     if (!m->top)
         return -1;
-    /* a cell's extremes over its corners, grown by the margin, in texels
-       from the plane's origin (the texel side is a power of two: exact) */
-    for (int p = 0; p < 2; p++) {
-        const double *ax = p ? m->v : m->u;
-        double lo = -SHADOW_MAP_MARGIN, hi = SHADOW_MAP_MARGIN;
-        for (int a = 0; a < 3; a++) {
-            lo += fmin(0.0, ax[a] * side);
-            hi += fmax(0.0, ax[a] * side);
-        }
-        const double o = p ? m->v0 : m->u0;
-        c.lo[p] = (lo - o) * m->inv_texel;
-        c.hi[p] = (hi - o) * m->inv_texel;
-    }
-    c.top = SHADOW_MAP_MARGIN;
-    for (int a = 0; a < 3; a++)
-        c.top += fmax(0.0, w[a] * side);
     const double *axes[3] = {m->u, m->v, m->w};
-    for (unsigned d = 0; d < c.depth; d++) {
+    for (unsigned d = 0; d <= c.depth; d++) {
         const double half = (double)(UINT32_C(1) << (levels - d - 1u));
         for (unsigned k = 0; k < 8; k++)
             for (int p = 0; p < 3; p++) {
@@ -257,6 +245,33 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
                                    (double)(k >> 1 & 1u) * half * ax[1] +
                                    (double)(k >> 2 & 1u) * half * ax[2];
             }
+    }
+    /* a child's extremes over its corners from its own corner, grown by the
+       margin; a cell's, those of its occupied children, in texels from the
+       plane's origin (the texel side is a power of two: exact) */
+    const double half = side / 2.0;
+    double clo[3], chi[3];
+    for (int p = 0; p < 3; p++) {
+        clo[p] = -SHADOW_MAP_MARGIN;
+        chi[p] = SHADOW_MAP_MARGIN;
+        for (int a = 0; a < 3; a++) {
+            clo[p] += fmin(0.0, axes[p][a] * half);
+            chi[p] += fmax(0.0, axes[p][a] * half);
+        }
+    }
+    for (unsigned mask = 0; mask < 256; mask++) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (unsigned k = 0; k < 8; k++)
+            for (int p = 0; mask >> k & 1u && p < 3; p++) {
+                lo[p] = fmin(lo[p], c.child[c.depth][k][p] + clo[p]);
+                hi[p] = fmax(hi[p], c.child[c.depth][k][p] + chi[p]);
+            }
+        for (int p = 0; p < 2; p++) {
+            const double o = p ? m->v0 : m->u0;
+            c.box[mask].lo[p] = (lo[p] - o) * m->inv_texel;
+            c.box[mask].hi[p] = (hi[p] - o) * m->inv_texel;
+        }
+        c.box[mask].top = hi[2];
     }
     if (tree->node_count[0] && put_cells(&c, threads ? threads : 1u) != 0) {
         shadow_map_free(m);

@@ -2,8 +2,9 @@
  * occupied cell (RENDER.md, "Shadows"). A ray parallel to the light projects
  * to one point of the plane across it; the map holds, per square of that
  * plane (a texel), the greatest height along the light of any occupied cell
- * of depth levels - SHADOW_MAP_UP whose projection meets the texel (each
- * cell's box of projected corners and its top grown by SHADOW_MAP_MARGIN).
+ * of depth levels - SHADOW_MAP_UP whose projection meets the texel (the
+ * boxes of projected corners of the cell's occupied children, and their top,
+ * grown by SHADOW_MAP_MARGIN).
  * A ray whose height has passed its texel's value meets no occupied voxel
  * after that: its shadow test can stop there with the same answer. */
 #ifndef SHADOW_MAP_H
