@@ -248,7 +248,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
     }
     /* a child's extremes over its corners from its own corner, grown by the
        margin; a cell's, those of its occupied children, in texels from the
-       plane's origin (the texel side is a power of two: exact) */
+       plane's origin (the texel side is a power of two: scaling by it is exact) */
     const double half = side / 2.0;
     double clo[3], chi[3];
     for (int p = 0; p < 3; p++) {
