@@ -87,34 +87,27 @@ static void put_cell(const build_ctx *c, float *top, const double p[3], unsigned
     }
 }
 
-/* Node n of depth d: its cells of the map's depth put into top. */
-static void put_node(const build_ctx *c, float *top, unsigned d, const map_node *n)
-{
-    const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
-    if (d == c->depth) {
-        put_cell(c, top, n->p, ch.mask);
-        return;
-    }
-    map_node k;
-    k.index = ch.first;
-    for (unsigned i = 0; i < 8; i++) {
-        if (!(ch.mask >> i & 1u))
-            continue;
-        for (int a = 0; a < 3; a++)
-            k.p[a] = n->p[a] + c->child[d][i][a];
-        put_node(c, top, d + 1u, &k);
-        k.index++;
-    }
-}
+/* Where a walk puts what it reaches at its stop depth: the nodes into list
+ * (the threads' subtrees), or, list NULL, the cells into top. */
+typedef struct walk_out {
+    float *top;
+    map_node *list;
+    size_t count;
+} walk_out;
 
-/* The nodes of depth `stop` under n (of depth d), in order, into c->split. */
-static void collect(build_ctx *c, unsigned d, unsigned stop, const map_node *n)
+/* Node n of depth d and the nodes under it down to depth `stop`, in order. */
+static void walk(const build_ctx *c, walk_out *out, unsigned d, unsigned stop,
+                 const map_node *n)
 {
-    if (d == stop) {
-        c->split[c->nsplit++] = *n;
+    if (d == stop && out->list) {
+        out->list[out->count++] = *n;
         return;
     }
     const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
+    if (d == stop) {
+        put_cell(c, out->top, n->p, ch.mask);
+        return;
+    }
     map_node k;
     k.index = ch.first;
     for (unsigned i = 0; i < 8; i++) {
@@ -122,7 +115,7 @@ static void collect(build_ctx *c, unsigned d, unsigned stop, const map_node *n)
             continue;
         for (int a = 0; a < 3; a++)
             k.p[a] = n->p[a] + c->child[d][i][a];
-        collect(c, d + 1u, stop, &k);
+        walk(c, out, d + 1u, stop, &k);
         k.index++;
     }
 }
@@ -141,7 +134,8 @@ static void *build_run(void *arg)
         const size_t k = atomic_fetch_add(&c->next, 1);
         if (k >= c->nsplit)
             return NULL;
-        put_node(c, w->top, d, &c->split[k]);
+        walk_out out = {w->top, NULL, 0};
+        walk(c, &out, d, c->depth, &c->split[k]);
     }
 }
 
@@ -162,9 +156,10 @@ static int put_cells(build_ctx *c, unsigned threads)
     c->split = malloc(((size_t)1 << (3 * d)) * sizeof *c->split);
     if (!c->split)
         return -1;
-    c->nsplit = 0;
     const map_node root = {0, {0.0, 0.0, 0.0}};
-    collect(c, 0, d, &root);
+    walk_out out = {NULL, c->split, 0};
+    walk(c, &out, 0, d, &root);
+    c->nsplit = out.count;
     atomic_init(&c->next, 0);
     if (threads > 8)
         threads = 8;
