@@ -428,6 +428,62 @@ static void test_grad_lanes(void **state)
     }
 }
 
+/* Lanes that share arguments, as a cell's children share each coordinate
+ * in halves: the lane evaluators take sin and cos once per distinct
+ * argument bits and copy them to the other lanes, which must still give
+ * each lane tape_eval_grad's and tape_eval's bits. The points are the
+ * corners of random boxes (two values an axis, every lane count), with
+ * signed zeros, whose sines differ in sign although -0 == +0. */
+static void test_lanes_shared_arguments(void **state)
+{
+    (void)state;
+    static const char *texts[] = {
+        "bounds -1 -1 -1 1 1 1\nsurface sin(x)*cos(y) + sin(y)*cos(z) + sin(z)*cos(x)\n",
+        "bounds -1 -1 -1 1 1 1\nsurface cos(x) - sin(x) + sin(x*y) + cos(z*3) + sin(z*3)\n",
+        "bounds -1 -1 -1 1 1 1\nsurface sin(x+y+z) + cos(x) + sin(y) + cos(z) + sin(x) + cos(y)\n",
+    };
+    static char text[16384];
+    double pts[TAPE_LANES][3];
+    for (size_t k = 0; k < sizeof texts / sizeof *texts; k++) {
+        scene *s = NULL;
+        scene_error e;
+        assert_int_equal(scene_parse(texts[k], strlen(texts[k]), &s, &e), 0);
+        for (int i = 0; i < 4000 / SCALE; i++) {
+            double c[3][2];
+            for (int a = 0; a < 3; a++) {
+                c[a][0] = 2.0 * unit() - 1.0;
+                c[a][1] = i % 4 == 0 ? -c[a][0] : c[a][0] + ldexp(1.0, -(int)(1 + i % 40));
+                if (i % 7 == 0) { /* signed zeros side by side */
+                    c[a][0] = 0.0;
+                    c[a][1] = -0.0;
+                }
+            }
+            unsigned lanes = 1 + (unsigned)i % TAPE_LANES;
+            for (unsigned l = 0; l < lanes; l++)
+                for (int a = 0; a < 3; a++)
+                    pts[l][a] = c[a][(l >> a) & 1u]; /* lane l: child l's corner */
+            check_lanes(&s->surfaces[0].tape, (const double(*)[3])pts, lanes, texts[k]);
+        }
+        scene_free(s);
+    }
+    /* random trees of every operation, their lanes on two values an axis */
+    for (int n = 0; n < 2000 / SCALE; n++) {
+        scene *s = rand_tree(text, sizeof text);
+        interval box[3];
+        rand_tree_box(box);
+        double c[3][2];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 2; b++)
+                c[a][b] = in_box(box[a]);
+        unsigned lanes = 1 + (unsigned)n % TAPE_LANES;
+        for (unsigned l = 0; l < lanes; l++)
+            for (int a = 0; a < 3; a++)
+                pts[l][a] = c[a][(l >> a) & 1u];
+        check_lanes(&s->surfaces[0].tape, (const double(*)[3])pts, lanes, text);
+        scene_free(s);
+    }
+}
+
 /* The gradient evaluators take sin and cos of one argument together
  * (sincos): the value and the derivative must keep the bits of sin and cos
  * called apart, as tape_eval computes them, over many magnitudes. */
@@ -503,6 +559,7 @@ int main(void)
         cmocka_unit_test(test_gradient_vs_differences),
         cmocka_unit_test(test_interval_scenes),
         cmocka_unit_test(test_grad_lanes),
+        cmocka_unit_test(test_lanes_shared_arguments),
         cmocka_unit_test(test_trig_gradient_bits),
         cmocka_unit_test(test_undefined_points),
     };

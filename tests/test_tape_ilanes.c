@@ -162,6 +162,60 @@ static void test_scenes(void **state)
     assert_true(nscenes >= 10);
 }
 
+/* Boxes that share coordinates, as a cell's eight children share each
+ * axis's two halves: the lane evaluators take the sine and cosine
+ * enclosures once per distinct argument and copy them, with their flags,
+ * to the other lanes. Each lane must still give the scalar bits and flags:
+ * narrow and wide trig arguments, signed-zero points ([-0,-0] beside
+ * [+0,+0]), infinite ends. */
+static void test_shared_boxes(void **state)
+{
+    (void)state;
+    static const char *texts[] = {
+        "bounds -1 -1 -1 1 1 1\nsurface sin(x)*cos(y) + sin(y)*cos(z) + sin(z)*cos(x)\n",
+        "bounds -1 -1 -1 1 1 1\nsurface cos(3*x) - sin(3*x) + sin(x*y) + cos(z) + tan(z)\n",
+    };
+    static char text[16384];
+    interval box[TAPE_LANES][3];
+    for (size_t k = 0; k < sizeof texts / sizeof *texts + 1; k++) {
+        scene *s = NULL;
+        scene_error e;
+        for (int i = 0; i < 3000 / SCALE; i++) {
+            if (k == sizeof texts / sizeof *texts) { /* random trees */
+                s = rand_tree(text, sizeof text);
+            } else if (!s) {
+                assert_int_equal(scene_parse(texts[k], strlen(texts[k]), &s, &e), 0);
+            }
+            interval half[3][2];
+            for (int a = 0; a < 3; a++) {
+                rand_box(box[0]);
+                const double lo = box[0][a].lo, hi = box[0][a].hi;
+                const double mid = isfinite(lo) && isfinite(hi) ? lo + 0.5 * (hi - lo) : 0.0;
+                half[a][0] = (interval){lo, mid < lo ? lo : mid};
+                half[a][1] = (interval){mid > hi ? hi : mid, hi};
+                if (i % 5 == 0) { /* signed-zero points side by side */
+                    half[a][0] = (interval){0.0, 0.0};
+                    half[a][1] = (interval){-0.0, -0.0};
+                }
+            }
+            const unsigned lanes = 1 + (unsigned)i % TAPE_LANES;
+            for (unsigned l = 0; l < lanes; l++)
+                for (int a = 0; a < 3; a++)
+                    box[l][a] = half[a][(l >> a) & 1u];
+            const tape *t = &s->surfaces[0].tape;
+            for (int p = 0; p < TAPE_PATHS; p++)
+                if (tape_lanes_path_available(p))
+                    check(p, t, (const interval(*)[3])box, lanes,
+                          k < sizeof texts / sizeof *texts ? texts[k] : text);
+            if (k == sizeof texts / sizeof *texts) {
+                scene_free(s);
+                s = NULL;
+            }
+        }
+        scene_free(s);
+    }
+}
+
 /* The path in use is one that is available; DDA_SIMD=portable (test
  * builds) selects the portable one. */
 static void test_path_choice(void **state)
@@ -184,6 +238,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_random_trees),
         cmocka_unit_test(test_scenes),
+        cmocka_unit_test(test_shared_boxes),
         cmocka_unit_test(test_path_choice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -175,17 +175,26 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
         j = m->next++ % TRIG_MEMO;
         m->arg[j] = slot;
         /* interval_sincos in lanes: the narrow lanes' midpoints, one
-         * sincos each, then their forms side by side. */
+         * sincos each, then their forms side by side; a lane whose
+         * argument has an earlier lane's bits (a cell's children share
+         * each coordinate in halves) takes that lane's results and flags. */
         double mid[W], sm[W], cm[W];
-        unsigned narrow = 0;
+        unsigned narrow = 0, copy = 0, same[W], lf[W];
         for (unsigned l = 0; l < n; l++) {
+            same[l] = il_first_same(a, l);
+            lf[l] = 0;
+            if (same[l] < l) {
+                copy |= 1u << l;
+                continue;
+            }
             interval x = il_get(a, l);
             if (interval__sincos_narrow(x)) {
                 narrow |= 1u << l;
                 mid[l] = interval__sincos_mid(x);
             } else {
                 interval sv, cv;
-                interval_sincos(x, &sv, &cv, &fl[l]);
+                interval_sincos(x, &sv, &cv, &lf[l]);
+                fl[l] |= lf[l];
                 il_set(&m->s[j], l, sv);
                 il_set(&m->c[j], l, cv);
             }
@@ -199,6 +208,13 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
                 double h = interval__sincos_half(x, mid[l]), q = 0.5 * h * h;
                 il_set(&m->s[j], l, interval__sincos_form(sm[l], cm[l], h, q));
                 il_set(&m->c[j], l, interval__sincos_form(cm[l], sm[l], h, q));
+            }
+        for (unsigned l = 0; l < n; l++)
+            if (copy >> l & 1) {
+                const unsigned e = same[l];
+                il_set(&m->s[j], l, il_get(&m->s[j], e));
+                il_set(&m->c[j], l, il_get(&m->c[j], e));
+                fl[l] |= lf[e];
             }
         for (unsigned l = n; l < W; l++) {
             m->s[j].lo[l] = m->s[j].lo[0];

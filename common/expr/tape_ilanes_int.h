@@ -32,6 +32,23 @@ static inline void il_set(tape_ilanes *v, unsigned l, interval x)
     v->hi[l] = x.hi;
 }
 
+/* The first of v's lanes 0..l whose ends have the bits of lane l's (l
+ * itself when no earlier one does). */
+static inline unsigned il_first_same(const tape_ilanes *v, unsigned l)
+{
+    uint64_t lo, hi;
+    memcpy(&lo, &v->lo[l], sizeof lo);
+    memcpy(&hi, &v->hi[l], sizeof hi);
+    for (unsigned j = 0; j < l; j++) {
+        uint64_t a, b;
+        memcpy(&a, &v->lo[j], sizeof a);
+        memcpy(&b, &v->hi[j], sizeof b);
+        if (a == lo && b == hi)
+            return j;
+    }
+    return l;
+}
+
 static inline tape_idual igl_get(const tape_idual_lanes *v, unsigned l)
 {
     tape_idual r = {il_get(&v->v, l), {il_get(&v->d[0], l), il_get(&v->d[1], l), il_get(&v->d[2], l)}};

@@ -4,6 +4,8 @@
 #define TAPE_INT_H
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "common/expr/tape.h"
 
@@ -26,12 +28,76 @@ static inline void point_sincos(double x, double *s, double *c)
 #endif
 }
 
+/* The first of lanes x[0..l] with the bits of x[l] (l itself when no
+ * earlier one has them). Bits, not ==: -0 and +0 have sines of opposite
+ * signs. */
+static inline unsigned lane_first_same(const double *x, unsigned l)
+{
+    uint64_t b;
+    memcpy(&b, &x[l], sizeof b);
+    for (unsigned j = 0; j < l; j++) {
+        uint64_t bj;
+        memcpy(&bj, &x[j], sizeof bj);
+        if (bj == b)
+            return j;
+    }
+    return l;
+}
+
+/* point_sincos of x[0..n-1], one call per distinct
+ * argument: a lane whose argument has an earlier lane's bits takes that
+ * lane's results (the same call on the same bits gives the same bits). A
+ * cell's children share each coordinate in halves, so sin(3 pi x) at a
+ * leaf-parent's eight voxel centres takes two calls, not eight. */
+static inline void point_sincos_lanes(const double *x, unsigned n, double *s, double *c)
+{
+    for (unsigned l = 0; l < n; l++) {
+        const unsigned j = lane_first_same(x, l);
+        if (j < l) {
+            s[l] = s[j];
+            c[l] = c[j];
+        } else {
+            point_sincos(x[l], &s[l], &c[l]);
+        }
+    }
+}
+
+/* The point lanes' sin and cos of the last TRIG_MEMO argument slots of one
+ * evaluation (slots are written once): sin(a) and cos(a) share one
+ * point_sincos_lanes. Its arrays are the widest lane count's. */
+#define TRIG_MEMO 4
+typedef struct trig_memo_lanes {
+    uint32_t arg[TRIG_MEMO];
+    double s[TRIG_MEMO][TAPE_LANES], c[TRIG_MEMO][TAPE_LANES];
+    unsigned next;
+} trig_memo_lanes;
+
+static inline void trig_memo_lanes_init(trig_memo_lanes *m)
+{
+    for (unsigned j = 0; j < TRIG_MEMO; j++)
+        m->arg[j] = UINT32_MAX;
+    m->next = 0;
+}
+
+/* The memo's entry for argument slot a (values x[0..n-1]), made on a miss;
+ * lanes n.. of the entry are left as they are (the callers fill them). */
+static inline unsigned trig_memo_lanes_entry(trig_memo_lanes *m, uint32_t a, const double *x,
+                                             unsigned n)
+{
+    for (unsigned j = 0; j < TRIG_MEMO; j++)
+        if (m->arg[j] == a)
+            return j;
+    unsigned j = m->next++ % TRIG_MEMO;
+    m->arg[j] = a;
+    point_sincos_lanes(x, n, m->s[j], m->c[j]);
+    return j;
+}
+
 /* The enclosures of sin and cos over the last TRIG_MEMO arguments of a
  * trigonometric instruction in one evaluation (slots are written once), so
  * that the sin and cos of one argument (gyroid's sin(3 pi x) and
  * cos(3 pi x)) share one interval_sincos: the same bits as two calls, and
  * the flags the first one raised are already in the evaluation's. */
-#define TRIG_MEMO 4
 typedef struct trig_memo {
     uint32_t arg[TRIG_MEMO];
     interval s[TRIG_MEMO], c[TRIG_MEMO];

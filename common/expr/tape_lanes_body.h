@@ -25,6 +25,8 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
     double pt[3][W]; /* the points, lanes from n on repeating lane 0, made once a pass */
+    trig_memo_lanes tm;
+    trig_memo_lanes_init(&tm);
     LANES {
         pt[0][l] = x[l < n ? l : 0];
         pt[1][l] = y[l < n ? l : 0];
@@ -88,22 +90,18 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             SCALE(r, A, m);
             break;
         case TAPE_SIN:
-            for (unsigned l = 0; l < n; l++)
-                point_sincos(A->v[l], &r->v[l], &m[l]);
-            fill(r->v, n);
-            fill(m, n);
-            SCALE(r, A, m);
-            break;
-        case TAPE_COS:
+        case TAPE_COS: {
+            const unsigned j = trig_memo_lanes_entry(&tm, in[i].a, A->v, n);
+            const double *sv = tm.s[j], *cv = tm.c[j];
             for (unsigned l = 0; l < n; l++) {
-                double sv;
-                point_sincos(A->v[l], &sv, &r->v[l]);
-                m[l] = -sv;
+                r->v[l] = op == TAPE_SIN ? sv[l] : cv[l];
+                m[l] = op == TAPE_SIN ? cv[l] : -sv[l];
             }
             fill(r->v, n);
             fill(m, n);
             SCALE(r, A, m);
             break;
+        }
         case TAPE_TAN:
             for (unsigned l = 0; l < n; l++)
                 r->v[l] = tan(A->v[l]);

@@ -12,6 +12,8 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
 {
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
+    trig_memo_lanes tm;
+    trig_memo_lanes_init(&tm);
     for (uint32_t i = 0, len = t->n; i < len; i++) {
         double *restrict r = s[i].v;
         uint32_t op = in[i].op;
@@ -45,15 +47,13 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             break;
         case TAPE_ABS: LANES r[l] = fabs(A[l]); break;
         case TAPE_SIN:
-            for (unsigned l = 0; l < n; l++)
-                r[l] = sin(A[l]);
+        case TAPE_COS: {
+            /* sincos's bits are sin's and cos's (point_sincos) */
+            const unsigned j = trig_memo_lanes_entry(&tm, in[i].a, A, n);
+            memcpy(r, op == TAPE_SIN ? tm.s[j] : tm.c[j], n * sizeof r[0]);
             fill(r, n);
             break;
-        case TAPE_COS:
-            for (unsigned l = 0; l < n; l++)
-                r[l] = cos(A[l]);
-            fill(r, n);
-            break;
+        }
         case TAPE_TAN:
             for (unsigned l = 0; l < n; l++)
                 r[l] = tan(A[l]);
