@@ -9,7 +9,8 @@ int oct_sink_put(oct_sink *s, const void *data, size_t n)
 {
     if (n == 0)
         return 0;
-    s->crc = crc32_z(s->crc, data, n);
+    if (!s->no_crc)
+        s->crc = crc32_z(s->crc, data, n);
     s->bytes += n;
     /* glibc may report a failed flush inside fwrite only through the error
      * flag, so both are checked: the caller stops at the first failure. */

@@ -13,6 +13,7 @@ typedef struct oct_sink {
     FILE *f; /* NULL: count and checksum only */
     uLong crc;
     uint64_t bytes;
+    int no_crc; /* 1: the CRC is not kept (the writer's second pass knows it) */
 } oct_sink;
 
 /* 0, or -1 with errno set (EIO when the stream gave no reason). */

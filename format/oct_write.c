@@ -303,7 +303,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             lay.off[k] = oct_align_up(end);
             end = lay.off[k] + size;
         }
-        oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0};
+        oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0, 0};
         put_section(w, k, &crc);
         lay.crc[k] = (uint32_t)crc.crc;
     }
@@ -311,7 +311,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
 
     unsigned char h[OCT_HEADER_SIZE_1_1];
     build_header(w, &lay, h, hsize);
-    oct_sink s = {f, 0, 0};
+    oct_sink s = {f, 0, 0, 1}; /* the CRCs are in the header already */
     errno = 0;
     if (oct_sink_put(&s, h, hsize) != 0)
         return OCT_EIO;
