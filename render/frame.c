@@ -519,14 +519,15 @@ int frame_render(const frame_job *job, frame_stats *stats)
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     const size_t ntiles = (size_t)sh.tiles_x * sh.tiles_y;
     int rc = 0;
-    shadow_map smap;
+    shadow_map_cache own_maps = {0};
+    shadow_map_cache *maps = job->shadow_maps ? job->shadow_maps : &own_maps;
     if (job->shade.shadows) {
-        /* made before the passes on all the threads: its time is the
-           shadow rays' */
+        /* made before the passes on all the threads (or kept from the last
+           frame): its time is the shadow rays' */
         const double t0 = job->timing ? frame_now_ns() : 0.0;
-        if (shadow_map_build(job->tree, job->shade.light, job->threads, &smap) == 0)
-            sh.shadow_map = &smap;
-        if (job->timing)
+        int built;
+        sh.shadow_map = shadow_map_cached(maps, job->tree, job->shade.light, job->threads, &built);
+        if (job->timing && built)
             sy.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
     }
     if (job->aa > 1) {
@@ -548,8 +549,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
     }
     frame_border_free(sh.border, ntiles);
     free(sh.border_hit);
-    if (job->shade.shadows)
-        shadow_map_free(&smap);
+    shadow_map_cache_free(&own_maps);
     exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;

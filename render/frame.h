@@ -41,6 +41,9 @@ typedef struct frame_job {
     int no_packets;     /* 1: every antialiasing sample traced alone, not in
                            packets (trace_packet.h; tests compare the two) */
     trace_traverse_fn traverse; /* NULL: the build's preferred implementation */
+    struct shadow_map_cache *shadow_maps; /* with shadows: the map kept from frame to
+                                             frame (shadow_map.h); NULL: made and
+                                             freed in each frame */
     int timing;         /* 1: time the secondary rays apart (frame_stats) */
     /* Called by the calling thread after each tile it finishes, with tiles
      * done so far and the total; may be NULL. */

@@ -26,6 +26,7 @@
 #include "render/map_guard.h"
 #include "render/outputs.h"
 #include "render/shade.h"
+#include "render/shadow_map.h"
 #include "render/trace.h"
 #include "render/view_report.h"
 #include "render/views.h"
@@ -402,7 +403,7 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
  * totals. Returns EXIT_OK or EXIT_RUNTIME. */
 static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
                        const camera *cam, const render_buffers *buf, const exact_scene *es,
-                       double *total_ms, uint64_t *total_rays)
+                       shadow_map_cache *maps, double *total_ms, uint64_t *total_rays)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
@@ -427,6 +428,7 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     job.aa = (unsigned)v->aa;
     job.alpha = v->alpha ? buf->alpha : NULL;
     job.shade.shadows = v->shadows;
+    job.shadow_maps = maps;
     job.shade.ao_rays = (unsigned)v->ao;
     job.timing = o->verbose;
     if (!o->quiet && diag_stderr_is_tty())
@@ -472,16 +474,21 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
     uint64_t total_rays = 0;
     size_t first = o->part_count ? (size_t)o->part_index : 0, step = o->part_count ? (size_t)o->part_count : 1;
     size_t done = 0;
+    shadow_map_cache maps = {0}; /* one map for the views under one light */
     for (size_t k = first; k < nviews; k += step, done++) {
         test_hooks_view((unsigned)k + 1);
-        if (map_guard_changed()) {
+        int st = EXIT_RUNTIME;
+        if (map_guard_changed())
             diag_path_error(o->oct_path, "changed while being read");
-            return EXIT_RUNTIME;
-        }
-        int st = render_view(tree, o, &list[k], &cams[k], buf, es, &total_ms, &total_rays);
-        if (st != EXIT_OK)
+        else
+            st = render_view(tree, o, &list[k], &cams[k], buf, es, &maps, &total_ms,
+                             &total_rays);
+        if (st != EXIT_OK) {
+            shadow_map_cache_free(&maps);
             return st;
+        }
     }
+    shadow_map_cache_free(&maps);
     if (!o->quiet && o->part_count)
         fprintf(stderr, "render: part %ld/%ld: %zu of %zu views\n", o->part_index, o->part_count, done,
                 nviews);

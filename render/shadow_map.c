@@ -281,6 +281,27 @@ void shadow_map_free(shadow_map *m)
     m->top = NULL;
 }
 
+const shadow_map *shadow_map_cached(shadow_map_cache *c, const oct_tree *tree,
+                                    const double light[3], unsigned threads, int *built)
+{
+    *built = 0;
+    if (c->tree == tree && memcmp(c->map.light, light, sizeof c->map.light) == 0)
+        return &c->map;
+    shadow_map_cache_free(c);
+    *built = 1;
+    if (shadow_map_build(tree, light, threads, &c->map) != 0)
+        return NULL;
+    c->tree = tree;
+    return &c->map;
+}
+
+void shadow_map_cache_free(shadow_map_cache *c)
+{
+    if (c->tree)
+        shadow_map_free(&c->map);
+    c->tree = NULL;
+}
+
 double shadow_map_clear_t(const shadow_map *m, const double g[3], const double light[3],
                           double scale)
 {

@@ -37,6 +37,22 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
                      shadow_map *m);
 void shadow_map_free(shadow_map *m); /* accepts a failed build */
 
+/* The map of the last frame, kept for the next ones: a map depends on the
+ * tree and the light alone, so the views of one file under one --light (a
+ * views file, an orbit) make it once. */
+typedef struct shadow_map_cache {
+    const oct_tree *tree; /* NULL: none kept */
+    shadow_map map;
+} shadow_map_cache;
+
+/* The map of tree and light: c's when it was made for both (the light's
+ * bits), else made anew into c on up to `threads` threads (*built = 1).
+ * NULL when the memory cannot be had (then rays go without a map). c must
+ * start zeroed; free with shadow_map_cache_free. */
+const shadow_map *shadow_map_cached(shadow_map_cache *c, const oct_tree *tree,
+                                    const double light[3], unsigned threads, int *built);
+void shadow_map_cache_free(shadow_map_cache *c);
+
 /* For the ray g + t (scale * light), g a grid point and scale the tree's
  * N / edge: a t after which the ray meets no occupied voxel (-inf when it
  * meets none at all, +inf when the map cannot tell: light not m's, no map). */

@@ -19,6 +19,7 @@
 #include "common/view/image.h"
 #include "render/frame.h"
 #include "render/shadow.h"
+#include "render/shadow_map.h"
 #include "tests/voxel_shapes.h"
 
 #define LEVELS 7
@@ -27,8 +28,9 @@
 #define SLAB 30.5
 static const double ball_c[3] = {64, 64, 70}, ball_r = 20;
 
-static void render(const oct_tree *t, const camera *cam, const double light[3], int refine,
-                   trace_traverse_fn fn, unsigned threads, uint8_t *rgb, float *depth)
+static void render_kept(const oct_tree *t, const camera *cam, const double light[3], int refine,
+                        trace_traverse_fn fn, unsigned threads, shadow_map_cache *maps,
+                        uint8_t *rgb, float *depth)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
@@ -44,9 +46,16 @@ static void render(const oct_tree *t, const camera *cam, const double light[3], 
     job.threads = threads;
     job.beam_size = FRAME_BEAM_DEFAULT;
     job.traverse = fn;
+    job.shadow_maps = maps;
     frame_stats st;
     assert_int_equal(frame_render(&job, &st), 0);
     assert_true(st.shadow_rays > 0);
+}
+
+static void render(const oct_tree *t, const camera *cam, const double light[3], int refine,
+                   trace_traverse_fn fn, unsigned threads, uint8_t *rgb, float *depth)
+{
+    render_kept(t, cam, light, refine, fn, threads, NULL, rgb, depth);
 }
 
 static void test_ball_shadow_on_slab(void **state)
@@ -122,10 +131,50 @@ static void test_ball_shadow_on_slab(void **state)
     tree_util_free(t);
 }
 
+/* Views under two lights in turn, one map kept from frame to frame
+ * (frame_job.shadow_maps, as render's views loop keeps it): each frame the
+ * same bytes as a frame that makes its own map, and the two lights' images
+ * differ. (That the kept map is remade for a new light is
+ * test_shadow_map's test_cache_follows_tree_and_light.) */
+static void test_kept_map_same_frames(void **state)
+{
+    (void)state;
+    shape sh[2] = {shape_plane(0, 0, 1, SLAB), shape_sphere(ball_c[0], ball_c[1], ball_c[2], ball_r)};
+    sh[1].surface = 1;
+    oct_tree *t = shapes_build(LEVELS, NV, sh, 2, 2);
+    assert_non_null(t);
+    const double eye[3] = {64, 64, 400}, target[3] = {64, 64, 0}, up[3] = {0, 1, 0};
+    camera cam;
+    assert_int_equal(camera_init(&cam, eye, target, up, 19.6, W, W), CAMERA_OK);
+    const double lights[3][3] = {{0.8, 0.3, 1.0}, {-0.5, 0.6, 1.0}, {0.8, 0.3, 1.0}};
+    uint8_t *rgb = malloc(W * W * 3), *ref = malloc(W * W * 3), *first = malloc(W * W * 3);
+    float *depth = malloc(W * W * sizeof *depth);
+    assert_true(rgb && ref && first && depth);
+    shadow_map_cache maps;
+    memset(&maps, 0, sizeof maps);
+    for (int k = 0; k < 3; k++) {
+        render(t, &cam, lights[k], 0, NULL, 2, ref, depth);
+        render_kept(t, &cam, lights[k], 0, NULL, 2, &maps, rgb, depth);
+        assert_memory_equal(rgb, ref, W * W * 3);
+        assert_non_null(maps.tree);
+        if (k == 0)
+            memcpy(first, rgb, W * W * 3);
+        else
+            assert_true((memcmp(first, rgb, W * W * 3) == 0) == (k == 2));
+    }
+    shadow_map_cache_free(&maps);
+    free(rgb);
+    free(ref);
+    free(first);
+    free(depth);
+    tree_util_free(t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ball_shadow_on_slab),
+        cmocka_unit_test(test_kept_map_same_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

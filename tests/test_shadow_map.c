@@ -141,6 +141,60 @@ static void test_same_map_any_threads(void **state)
     tree_util_free(t);
 }
 
+/* The map kept from frame to frame (shadow_map_cached): made again when
+ * the light's bits or the tree change, kept otherwise, and then the map a
+ * build from scratch gives, bit for bit. */
+static void check_same_map(const shadow_map *m, const oct_tree *t, const double light[3])
+{
+    shadow_map fresh;
+    assert_int_equal(shadow_map_build(t, light, 1, &fresh), 0);
+    assert_memory_equal(m->light, light, sizeof m->light);
+    assert_int_equal(m->nu, fresh.nu);
+    assert_int_equal(m->nv, fresh.nv);
+    assert_memory_equal(m->top, fresh.top, (size_t)fresh.nu * fresh.nv * sizeof *fresh.top);
+    shadow_map_free(&fresh);
+}
+
+static void test_cache_follows_tree_and_light(void **state)
+{
+    (void)state;
+    enum { LEVELS = 6 };
+    const uint32_t n = UINT32_C(1) << LEVELS;
+    uint64_t rng = 0xcac4e5u;
+    static uint32_t xyz[2][800][3];
+    oct_tree *t[2];
+    for (int k = 0; k < 2; k++) {
+        const size_t nv = tree_util_distinct_voxels(800, 0, n, &rng, xyz[k]);
+        t[k] = tree_util_simple(LEVELS, (const uint32_t(*)[3])xyz[k], nv);
+        assert_non_null(t[k]);
+    }
+    const double l1[3] = {-0.3, 0.45, 0.84}, l2[3] = {0.6, -0.2, 0.77};
+    const double l1z[3] = {-0.3, 0.45, 0.84 + 0x1p-52}; /* one ulp off l1 */
+    shadow_map_cache c;
+    memset(&c, 0, sizeof c);
+    int built = -1;
+    const shadow_map *m = shadow_map_cached(&c, t[0], l1, 2, &built);
+    assert_non_null(m);
+    assert_int_equal(built, 1);
+    check_same_map(m, t[0], l1);
+    assert_ptr_equal(shadow_map_cached(&c, t[0], l1, 1, &built), m);
+    assert_int_equal(built, 0); /* the same tree and light: kept */
+    m = shadow_map_cached(&c, t[0], l2, 2, &built);
+    assert_int_equal(built, 1);
+    check_same_map(m, t[0], l2);
+    m = shadow_map_cached(&c, t[0], l1z, 2, &built);
+    assert_int_equal(built, 1);
+    check_same_map(m, t[0], l1z);
+    m = shadow_map_cached(&c, t[1], l1z, 2, &built);
+    assert_int_equal(built, 1); /* another tree */
+    check_same_map(m, t[1], l1z);
+    shadow_map_cache_free(&c);
+    assert_null(c.tree);
+    shadow_map_cache_free(&c); /* twice: nothing kept, nothing freed */
+    for (int k = 0; k < 2; k++)
+        tree_util_free(t[k]);
+}
+
 /* Shadow rays from the hits of a view, stopped where the map says: the
  * answers of the rays traced whole, never more steps. */
 static void test_stopped_rays_same_answers(void **state)
@@ -231,6 +285,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_clear_t_bounds_every_voxel),
         cmocka_unit_test(test_same_map_any_threads),
+        cmocka_unit_test(test_cache_follows_tree_and_light),
         cmocka_unit_test(test_stopped_rays_same_answers),
         cmocka_unit_test(test_grid_hit_faces_eye),
     };
