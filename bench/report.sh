@@ -16,12 +16,20 @@ function mark(ok) { return ok ? " ✓" : " ✗" }'
 {
 echo "<!-- bench:begin -->"
 echo "<!-- written by bench/report.sh from $RES/*.csv: do not edit by hand -->"
+# The run a CSV's rows come from (its first row's machine, cores, date and
+# commit); the header names the first of these CSVs, and a table from
+# another run (SECTIONS ran a part only) says its own.
+prov() { awk -F, 'NR == 2 { printf "%s (%s cores), %s, commit %s", $1, $2, $3, $4 }' "$RES/$1.csv"; }
+HPROV=""
 for c in render rastspeed accuracy images; do
     if has $c; then
         awk -F, 'NR == 2 { printf "Measured on %s (%s cores), %s, commit %s (`make bench`, mode %s).\n", $1, $2, $3, $4, $5 }' "$RES/$c.csv"
+        HPROV=$(prov $c)
         break
     fi
 done
+# NAME: a line naming NAME.csv's run when it is not the header's
+own_run() { p=$(prov "$1"); [ "$p" = "$HPROV" ] || echo "These rows: $p."; }
 cat <<'TXT'
 Times are medians of several runs of the real binaries (`bin/rasterize`, wall time
 with start-up; `bin/render`, the per-frame time it prints, one mapping for all frames).
@@ -163,6 +171,7 @@ if has rastspeed; then
     echo "(✓ met, ✗ not met)."
     awk -F, 'NR > 1 && $8 > 60 { printf "%s%s levels %d %.0f s", n++ ? ", " : "Runs over a minute: ", $6, $7, $8 }
         END { if (n) print "." }' "$RES/rastspeed.csv"
+    own_run rastspeed
     echo
     echo "| scene | levels | seconds | voxels | M voxels/s (≥ 10) | CPU % | --shell-only s | M voxels/s (≥ 25) | CPU % |"
     echo "|---|---|---|---|---|---|---|---|---|"
@@ -177,6 +186,7 @@ if has shell; then
     echo "≤ 1.3), the real ones lost (must be 0), and the stored records against the exact surface"
     echo "(\`bench/normalerr\`: normal against the gradient at the foot point of the voxel centre, plane"
     echo "offset against the distance to it):"
+    own_run shell
     echo
     echo "| scene | levels | kept | real | kept / real (≤ 1.3) | real ones lost (0) | normal err mean / p99 / max ° | offset err mean / p99 voxel |"
     echo "|---|---|---|---|---|---|---|---|"
@@ -199,6 +209,7 @@ if has images; then
     echo "rays a second of each kind over thread time (\`render -v\`). Targets: \`--aa 4\` and \`--shadows\`"
     echo "at most 1.6x the time of one ray a pixel, \`--ao 16\` at most 8x; shadow and AO rays at no less"
     echo "than half the primary rate, the higher of the row's own and the plain run's (✓ met, ✗ not met):"
+    own_run images
     echo
     echo "| option | levels | size | ms | time / plain (target) | supersampled % | primary Mrays/s | shadow Mrays/s (≥ ½ primary) | AO Mrays/s (≥ ½ primary) |"
     echo "|---|---|---|---|---|---|---|---|---|"

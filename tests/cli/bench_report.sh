@@ -21,7 +21,7 @@ $P,csg,10,0.53,4446496,8.39,189,,,
 CSV
 cat >"$R/shell.csv" <<CSV
 $H,scene,levels,kept,real,ratio,lost,voxels_near,voxels_missed,normal_mean_deg,normal_p99_deg,normal_max_deg,offset_mean_vox,offset_p99_vox,offset_max_vox
-$P,blobs_b,9,954671,828476,1.4,0,927041,27630,0.0317,0.1719,0.5380,0.00196,0.00388,0.00594
+cpu,2,2026-12-05T10:00Z,def5678,full,blobs_b,9,954671,828476,1.4,0,927041,27630,0.0317,0.1719,0.5380,0.00196,0.00388,0.00594
 CSV
 cat >"$R/accuracy.csv" <<CSV
 $H,scene,levels,size,exact_ms,depth_mean_vox,depth_p99_vox,depth_max_vox,hitmiss_frac,normal_mean_deg,normal_p99_deg,normal_max_deg,nan_pixels,refcast_ms
@@ -51,6 +51,9 @@ has "| --aa 4 --shadows --ao 16 --exact | 10 | 1024² | 402.9 | 10.28 | 0.20 | 2
 has "| gyroid | 12 | 95.50 | 1000000000 | 10.47 ✓ | 190 | 30.10 | 33.20 ✓ | 195 |"
 has "| csg | 10 | 0.53 | 4446496 | 8.39 ✗ | 189 | - | - | - |"
 has "Runs over a minute: gyroid levels 12 96 s."
+# a table from another run than the header's names its own; the others do not
+has "These rows: cpu (2 cores), 2026-12-05T10:00Z, commit def5678."
+[ "$(grep -c '^These rows:' "$M")" = 1 ] || fail "a table of the header's run named its run"
 has "| blobs_b | 9 | 954671 | 828476 | 1.400 ✗ | 0 ✓ | 0.032 / 0.172 / 0.54 | 0.0020 / 0.0039 |"
 has "| cube | 9 | 0 / 0 | 0.000 | 7e-07 / 1.2e-06 / 1.2e-06 | 0 | 10.8 | 24 | all met ✓ |"
 has "| plate | 10 | 0.002 / 0.5 | 0.100 | 0.1 / 0.2 / 3 | 2 | 15.6 | 43 | ✗ mean p99 hit/miss normal NaN |"
