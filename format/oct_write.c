@@ -10,36 +10,84 @@
 #include <stdlib.h>
 #include <zlib.h>
 
+/* Bytes kept in chunks of STORE_CHUNK bytes: appending never moves what is stored. (A
+ * doubling realloc of hundreds of megabytes copies them on some systems and
+ * on others moves their pages, which a virtual machine may then fault in
+ * again one by one when they are next read: docs/perf-log.md.) */
+#define STORE_BITS 22
+#define STORE_CHUNK ((size_t)1 << STORE_BITS)
+typedef struct chunked {
+    unsigned char **c;
+    size_t nchunks, cap; /* chunks allocated, slots in c */
+    size_t n;            /* bytes stored */
+} chunked;
+
+/* Appends n bytes; -1 (nothing appended) when memory runs out. */
+static int chunked_append(chunked *a, const void *data, size_t n)
+{
+    if (n > SIZE_MAX - STORE_CHUNK - a->n)
+        return -1;
+    const size_t need = (a->n + n + STORE_CHUNK - 1) >> STORE_BITS;
+    if (need > a->cap) {
+        size_t cap = a->cap ? a->cap : 16;
+        while (cap < need)
+            cap *= 2;
+        unsigned char **c = oct__realloc(a->c, cap * sizeof *c);
+        if (!c)
+            return -1;
+        a->c = c;
+        a->cap = cap;
+    }
+    for (; a->nchunks < need; a->nchunks++) /* kept on failure: capacity */
+        if (!(a->c[a->nchunks] = oct__realloc(NULL, STORE_CHUNK)))
+            return -1;
+    const unsigned char *p = data;
+    while (n) {
+        const size_t off = a->n & (STORE_CHUNK - 1);
+        const size_t k = STORE_CHUNK - off < n ? STORE_CHUNK - off : n;
+        memcpy(a->c[a->n >> STORE_BITS] + off, p, k);
+        a->n += k;
+        p += k;
+        n -= k;
+    }
+    return 0;
+}
+
+static inline unsigned char chunked_at(const chunked *a, size_t i)
+{
+    return a->c[i >> STORE_BITS][i & (STORE_CHUNK - 1)];
+}
+
+/* The stored bytes into s, in order. */
+static int chunked_put(const chunked *a, oct_sink *s)
+{
+    for (size_t i = 0; i < a->n; i += STORE_CHUNK) {
+        const size_t k = a->n - i < STORE_CHUNK ? a->n - i : STORE_CHUNK;
+        if (oct_sink_put(s, a->c[i >> STORE_BITS], k) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+static void chunked_free(chunked *a)
+{
+    for (size_t i = 0; i < a->nchunks; i++)
+        free(a->c[i]);
+    free(a->c);
+    memset(a, 0, sizeof *a);
+}
+
 struct oct_writer {
     oct_writer_params p;
     float palette[OCT_MAX_SURFACES * 3];
-    uint8_t *masks[OCT_MAX_LEVELS];
-    size_t count[OCT_MAX_LEVELS], cap[OCT_MAX_LEVELS];
-    uint32_t *voxels;   /* NULL with OCT_FLAG_SHELL_ONLY: the records are not stored */
-    uint8_t *surfaces;
-    size_t voxel_count, voxel_cap, surface_cap;
+    chunked masks[OCT_MAX_LEVELS]; /* a byte a node: its count is the depth's node count */
+    chunked voxels;    /* 4 bytes a voxel (little-endian host); none with OCT_FLAG_SHELL_ONLY */
+    chunked surfaces;  /* a byte a voxel, with more than one surface */
+    size_t voxel_count;
     unsigned char *function; /* copy of the FUNCTION section, or NULL */
     int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
     int done; /* finish was called: the writer accepts nothing more */
 };
-
-static int grow(void **buf, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 0;
-    size_t c = *cap ? *cap : 4096;
-    while (c < need) {
-        if (c > SIZE_MAX / 2 / elem)
-            return -1;
-        c *= 2;
-    }
-    void *p = oct__realloc(*buf, c * elem);
-    if (!p)
-        return -1;
-    *buf = p;
-    *cap = c;
-    return 0;
-}
 
 static int finite_unit(float v) { return isfinite(v) && v >= 0.0f && v <= 1.0f; }
 
@@ -114,16 +162,7 @@ oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks
         if (masks[i] == 0)
             return OCT_EUSAGE; /* only non-empty nodes are stored */
     }
-    if (n > SIZE_MAX - w->count[depth])
-        return OCT_ENOMEM;
-    void *buf = w->masks[depth];
-    if (grow(&buf, &w->cap[depth], w->count[depth] + n, 1) != 0)
-        return OCT_ENOMEM;
-    w->masks[depth] = buf;
-    if (n)
-        memcpy(w->masks[depth] + w->count[depth], masks, n);
-    w->count[depth] += n;
-    return OCT_OK;
+    return chunked_append(&w->masks[depth], masks, n) == 0 ? OCT_OK : OCT_ENOMEM;
 }
 
 oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8_t *surfaces, size_t n)
@@ -137,23 +176,18 @@ oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8
         if (w->p.surface_count > 1 && surfaces[i] >= w->p.surface_count)
             return OCT_EUSAGE;
     }
-    if (n > SIZE_MAX - w->voxel_count)
+    if (n > SIZE_MAX / sizeof *voxels - w->voxel_count)
         return OCT_ENOMEM;
-    size_t need = w->voxel_count + n;
-    void *v = w->voxels, *s = w->surfaces;
-    if (!shell && grow(&v, &w->voxel_cap, need, sizeof(uint32_t)) != 0)
+    /* the surfaces first: when the voxels then fail, the surfaces appended
+       are taken back, so that the next call retries from the same state */
+    const size_t ns = w->surfaces.n;
+    if (w->p.surface_count > 1 && chunked_append(&w->surfaces, surfaces, n) != 0)
         return OCT_ENOMEM;
-    w->voxels = v;
-    if (w->p.surface_count > 1 && grow(&s, &w->surface_cap, need, 1) != 0)
-        return OCT_ENOMEM; /* voxel_count unchanged: the next call retries */
-    w->surfaces = s;
-    if (n) {
-        if (!shell)
-            memcpy(w->voxels + w->voxel_count, voxels, n * sizeof *voxels);
-        if (w->p.surface_count > 1)
-            memcpy(w->surfaces + w->voxel_count, surfaces, n);
+    if (!shell && chunked_append(&w->voxels, voxels, n * sizeof *voxels) != 0) {
+        w->surfaces.n = ns;
+        return OCT_ENOMEM;
     }
-    w->voxel_count = need;
+    w->voxel_count += n;
     return OCT_OK;
 }
 
@@ -165,14 +199,15 @@ static int put_nodes(const oct_writer *w, oct_sink *s)
     enum { CHUNK = 4096 };
     unsigned char buf[CHUNK * 16];
     for (uint32_t d = 0; d < w->p.levels; d++) {
-        uint64_t base = 0, n = w->count[d];
+        const chunked *m = &w->masks[d];
+        uint64_t base = 0, n = m->n;
         size_t fill = 0;
         for (uint64_t g = 0; g < groups_of(n); g++) {
             unsigned char *rec = buf + 16 * fill;
             wr_u64le(rec, base);
             for (unsigned k = 0; k < 8; k++) {
                 uint64_t i = 8 * g + k;
-                rec[8 + k] = i < n ? w->masks[d][i] : 0;
+                rec[8 + k] = i < n ? chunked_at(m, i) : 0;
                 base += oct_popcount64(rec[8 + k]);
             }
             if (++fill == CHUNK) {
@@ -200,7 +235,7 @@ static int put_section(const oct_writer *w, int k, oct_sink *s)
     case OCT_SEC_LEVELS:
         for (uint32_t d = 0; d < w->p.levels; d++) {
             unsigned char b[8];
-            wr_u64le(b, w->count[d]);
+            wr_u64le(b, w->masks[d].n);
             if (oct_sink_put(s, b, 8) != 0)
                 return -1;
         }
@@ -208,9 +243,9 @@ static int put_section(const oct_writer *w, int k, oct_sink *s)
     case OCT_SEC_NODES:
         return put_nodes(w, s);
     case OCT_SEC_VOXELS: /* little-endian host; nothing with OCT_FLAG_SHELL_ONLY */
-        return w->voxels ? oct_sink_put(s, w->voxels, w->voxel_count * sizeof(uint32_t)) : 0;
+        return chunked_put(&w->voxels, s);
     case OCT_SEC_SURFACES:
-        return w->p.surface_count > 1 ? oct_sink_put(s, w->surfaces, w->voxel_count) : 0;
+        return w->p.surface_count > 1 ? chunked_put(&w->surfaces, s) : 0;
     case OCT_SEC_PALETTE:
         return oct_sink_put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
     default:
@@ -267,17 +302,21 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
         return OCT_EUSAGE;
     w->done = 1;
     const uint32_t L = w->p.levels;
-    if (w->count[0] > 1)
+    if (w->masks[0].n > 1)
         return OCT_EUSAGE;
     for (uint32_t d = 0; d < L; d++) {
+        const chunked *m = &w->masks[d];
         uint64_t children = 0;
-        for (size_t i = 0; i < w->count[d]; i++)
-            children += oct_popcount64(w->masks[d][i]);
-        uint64_t want = d + 1 < L ? w->count[d + 1] : w->voxel_count;
+        for (size_t i = 0; i < m->n; i += STORE_CHUNK) {
+            const unsigned char *c = m->c[i >> STORE_BITS];
+            for (size_t j = 0, k = m->n - i < STORE_CHUNK ? m->n - i : STORE_CHUNK; j < k; j++)
+                children += oct_popcount64(c[j]);
+        }
+        uint64_t want = d + 1 < L ? w->masks[d + 1].n : w->voxel_count;
         if (children != want)
             return OCT_EUSAGE;
     }
-    if (L > 1 && w->count[0] == 0 && w->voxel_count != 0)
+    if (L > 1 && w->masks[0].n == 0 && w->voxel_count != 0)
         return OCT_EUSAGE;
 
     layout lay = {0};
@@ -291,9 +330,9 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
         case OCT_SEC_NODES:
             size = 0;
             for (uint32_t d = 0; d < L; d++)
-                size += 16 * groups_of(w->count[d]);
+                size += 16 * groups_of(w->masks[d].n);
             break;
-        case OCT_SEC_VOXELS: size = w->voxels ? 4 * (uint64_t)w->voxel_count : 0; break;
+        case OCT_SEC_VOXELS: size = w->voxels.n; break;
         case OCT_SEC_SURFACES: size = w->p.surface_count > 1 ? w->voxel_count : 0; break;
         case OCT_SEC_PALETTE: size = 12u * w->p.surface_count; break;
         default: size = w->function ? w->p.function_size : 0; break;
@@ -336,9 +375,9 @@ void oct_writer_free(oct_writer *w)
     if (!w)
         return;
     for (int d = 0; d < OCT_MAX_LEVELS; d++)
-        free(w->masks[d]);
-    free(w->voxels);
-    free(w->surfaces);
+        chunked_free(&w->masks[d]);
+    chunked_free(&w->voxels);
+    chunked_free(&w->surfaces);
     free(w->function);
     free(w);
 }

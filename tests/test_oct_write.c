@@ -16,6 +16,7 @@
 #include "format/oct.h"
 #include "format/oct_layout.h" /* oct__alloc_fail_after */
 #include "bench/oct_synth.h"
+#include "tests/oct_check.h"
 
 static void test_writer_usage_errors(void **state)
 {
@@ -241,12 +242,33 @@ static void test_allocation_failures(void **state)
     test_tree_free(&t);
 }
 
+/* A tree larger than the writer's storage chunks (4 MiB: 1 Mi voxel
+ * records): its arrays span several chunks and the appends cross their
+ * boundaries, and the file read back holds exactly the tree. */
+static void test_large_tree_spans_chunks(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 8, 2500000, 3, 99, 0);
+    assert_true(t.voxel_count * 4 > 2 * ((size_t)4 << 20));
+    unsigned char *out;
+    size_t len;
+    assert_int_equal(feed_writer(&t, 0, &out, &len), OCT_OK);
+    oct_file *f = NULL;
+    assert_int_equal(oct_open_memory(out, len, 0, &f, NULL), OCT_OK);
+    oct_check_tree(f, &t);
+    oct_close(f);
+    free(out);
+    test_tree_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_writer_usage_errors),
         cmocka_unit_test(test_writer_write_failures),
         cmocka_unit_test(test_allocation_failures),
+        cmocka_unit_test(test_large_tree_spans_chunks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
