@@ -58,16 +58,25 @@ static void render(const oct_tree *t, const camera *cam, const double light[3], 
     render_kept(t, cam, light, refine, fn, threads, NULL, rgb, depth);
 }
 
-static void test_ball_shadow_on_slab(void **state)
+static const double eye[3] = {64, 64, 400};
+
+/* The ball over the slab, and the camera above them. */
+static oct_tree *ball_over_slab(camera *cam)
 {
-    (void)state;
     shape sh[2] = {shape_plane(0, 0, 1, SLAB), shape_sphere(ball_c[0], ball_c[1], ball_c[2], ball_r)};
     sh[1].surface = 1;
     oct_tree *t = shapes_build(LEVELS, NV, sh, 2, 2);
     assert_non_null(t);
-    const double eye[3] = {64, 64, 400}, target[3] = {64, 64, 0}, up[3] = {0, 1, 0};
+    const double target[3] = {64, 64, 0}, up[3] = {0, 1, 0};
+    assert_int_equal(camera_init(cam, eye, target, up, 19.6, W, W), CAMERA_OK);
+    return t;
+}
+
+static void test_ball_shadow_on_slab(void **state)
+{
+    (void)state;
     camera cam;
-    assert_int_equal(camera_init(&cam, eye, target, up, 19.6, W, W), CAMERA_OK);
+    oct_tree *t = ball_over_slab(&cam);
     double light[3] = {0.8, 0.3, 1.0};
     const double ll = sqrt(light[0] * light[0] + light[1] * light[1] + light[2] * light[2]);
     for (int a = 0; a < 3; a++)
@@ -139,13 +148,8 @@ static void test_ball_shadow_on_slab(void **state)
 static void test_kept_map_same_frames(void **state)
 {
     (void)state;
-    shape sh[2] = {shape_plane(0, 0, 1, SLAB), shape_sphere(ball_c[0], ball_c[1], ball_c[2], ball_r)};
-    sh[1].surface = 1;
-    oct_tree *t = shapes_build(LEVELS, NV, sh, 2, 2);
-    assert_non_null(t);
-    const double eye[3] = {64, 64, 400}, target[3] = {64, 64, 0}, up[3] = {0, 1, 0};
     camera cam;
-    assert_int_equal(camera_init(&cam, eye, target, up, 19.6, W, W), CAMERA_OK);
+    oct_tree *t = ball_over_slab(&cam);
     const double lights[3][3] = {{0.8, 0.3, 1.0}, {-0.5, 0.6, 1.0}, {0.8, 0.3, 1.0}};
     uint8_t *rgb = malloc(W * W * 3), *ref = malloc(W * W * 3), *first = malloc(W * W * 3);
     float *depth = malloc(W * W * sizeof *depth);

@@ -160,20 +160,16 @@ static void LIBM_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a,
 /* sin or cos of slot a, lane by lane as LIBM_FN, through a memo of the last
  * TRIG_MEMO arguments' sin and cos (tape_int.h's trig_memo, in lanes). */
 typedef struct TRIG_MEMO_T {
-    uint32_t arg[TRIG_MEMO];
+    trig_memo_keys k;
     tape_ilanes s[TRIG_MEMO], c[TRIG_MEMO];
-    unsigned next;
 } TRIG_MEMO_T;
 
 static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint32_t slot,
                     int is_cos, TRIG_MEMO_T *m, unsigned n, unsigned *fl)
 {
-    unsigned j = 0;
-    while (j < TRIG_MEMO && m->arg[j] != slot)
-        j++;
-    if (j == TRIG_MEMO) {
-        j = m->next++ % TRIG_MEMO;
-        m->arg[j] = slot;
+    int miss;
+    const unsigned j = trig_memo_find(&m->k, slot, &miss);
+    if (miss) {
         /* interval_sincos in lanes: the narrow lanes' midpoints, one
          * sincos each, then their forms side by side; a lane whose
          * argument has an earlier lane's bits (a cell's children share
@@ -233,9 +229,7 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
     TRIG_MEMO_T tm; /* entries are written before they are read */
-    for (unsigned j = 0; j < TRIG_MEMO; j++)
-        tm.arg[j] = UINT32_MAX;
-    tm.next = 0;
+    trig_memo_keys_init(&tm.k);
     for (uint32_t i = 0, len = t->n; i < len; i++) {
         tape_ilanes *restrict r = &s[i];
         uint32_t op = in[i].op;

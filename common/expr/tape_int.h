@@ -44,11 +44,11 @@ static inline unsigned lane_first_same(const double *x, unsigned l)
     return l;
 }
 
-/* point_sincos of x[0..n-1], one call per distinct
- * argument: a lane whose argument has an earlier lane's bits takes that
- * lane's results (the same call on the same bits gives the same bits). A
- * cell's children share each coordinate in halves, so sin(3 pi x) at a
- * leaf-parent's eight voxel centres takes two calls, not eight. */
+/* point_sincos of x[0..n-1], one call per distinct argument: a lane whose
+ * argument has an earlier lane's bits takes that lane's results (the same
+ * call on the same bits gives the same bits). A cell's children share each
+ * coordinate in halves, so sin(3 pi x) at a leaf-parent's eight voxel
+ * centres takes two calls, not eight. */
 static inline void point_sincos_lanes(const double *x, unsigned n, double *s, double *c)
 {
     for (unsigned l = 0; l < n; l++) {
@@ -62,64 +62,73 @@ static inline void point_sincos_lanes(const double *x, unsigned n, double *s, do
     }
 }
 
-/* The point lanes' sin and cos of the last TRIG_MEMO argument slots of one
- * evaluation (slots are written once): sin(a) and cos(a) share one
- * point_sincos_lanes. Its arrays are the widest lane count's. */
+/* The sin and cos of the last TRIG_MEMO argument slots of a trigonometric
+ * instruction in one evaluation (slots are written once), so that the sin
+ * and cos of one argument (gyroid's sin(3 pi x) and cos(3 pi x)) share one
+ * evaluation: the same bits as two, and the flags the first one raised are
+ * already in the evaluation's. trig_memo_keys is the part every memo (one
+ * interval, one lane set) shares: which slots its entries hold. */
 #define TRIG_MEMO 4
-typedef struct trig_memo_lanes {
+typedef struct trig_memo_keys {
     uint32_t arg[TRIG_MEMO];
-    double s[TRIG_MEMO][TAPE_LANES], c[TRIG_MEMO][TAPE_LANES];
     unsigned next;
-} trig_memo_lanes;
+} trig_memo_keys;
 
-static inline void trig_memo_lanes_init(trig_memo_lanes *m)
+static inline void trig_memo_keys_init(trig_memo_keys *k)
 {
     for (unsigned j = 0; j < TRIG_MEMO; j++)
-        m->arg[j] = UINT32_MAX;
-    m->next = 0;
+        k->arg[j] = UINT32_MAX;
+    k->next = 0;
 }
+
+/* The entry holding slot a; on a miss (*miss = 1) the oldest, given to a. */
+static inline unsigned trig_memo_find(trig_memo_keys *k, uint32_t a, int *miss)
+{
+    *miss = 0;
+    for (unsigned j = 0; j < TRIG_MEMO; j++)
+        if (k->arg[j] == a)
+            return j;
+    unsigned j = k->next++ % TRIG_MEMO;
+    k->arg[j] = a;
+    *miss = 1;
+    return j;
+}
+
+/* The scalar interval evaluators' memo. */
+typedef struct trig_memo {
+    trig_memo_keys k;
+    interval s[TRIG_MEMO], c[TRIG_MEMO];
+} trig_memo;
+
+static inline void trig_memo_init(trig_memo *m) { trig_memo_keys_init(&m->k); }
+
+/* The memo's entry for argument slot a (value x), made on a miss. */
+static inline unsigned trig_memo_entry(trig_memo *m, uint32_t a, interval x, unsigned *flags)
+{
+    int miss;
+    const unsigned j = trig_memo_find(&m->k, a, &miss);
+    if (miss)
+        interval_sincos(x, &m->s[j], &m->c[j], flags);
+    return j;
+}
+
+/* The point lanes' memo; its arrays are the widest lane count's. */
+typedef struct trig_memo_lanes {
+    trig_memo_keys k;
+    double s[TRIG_MEMO][TAPE_LANES], c[TRIG_MEMO][TAPE_LANES];
+} trig_memo_lanes;
+
+static inline void trig_memo_lanes_init(trig_memo_lanes *m) { trig_memo_keys_init(&m->k); }
 
 /* The memo's entry for argument slot a (values x[0..n-1]), made on a miss;
  * lanes n.. of the entry are left as they are (the callers fill them). */
 static inline unsigned trig_memo_lanes_entry(trig_memo_lanes *m, uint32_t a, const double *x,
                                              unsigned n)
 {
-    for (unsigned j = 0; j < TRIG_MEMO; j++)
-        if (m->arg[j] == a)
-            return j;
-    unsigned j = m->next++ % TRIG_MEMO;
-    m->arg[j] = a;
-    point_sincos_lanes(x, n, m->s[j], m->c[j]);
-    return j;
-}
-
-/* The enclosures of sin and cos over the last TRIG_MEMO arguments of a
- * trigonometric instruction in one evaluation (slots are written once), so
- * that the sin and cos of one argument (gyroid's sin(3 pi x) and
- * cos(3 pi x)) share one interval_sincos: the same bits as two calls, and
- * the flags the first one raised are already in the evaluation's. */
-typedef struct trig_memo {
-    uint32_t arg[TRIG_MEMO];
-    interval s[TRIG_MEMO], c[TRIG_MEMO];
-    unsigned next;
-} trig_memo;
-
-static inline void trig_memo_init(trig_memo *m)
-{
-    for (unsigned j = 0; j < TRIG_MEMO; j++)
-        m->arg[j] = UINT32_MAX;
-    m->next = 0;
-}
-
-/* The memo's entry for argument slot a (value x), made on a miss. */
-static inline unsigned trig_memo_entry(trig_memo *m, uint32_t a, interval x, unsigned *flags)
-{
-    for (unsigned j = 0; j < TRIG_MEMO; j++)
-        if (m->arg[j] == a)
-            return j;
-    unsigned j = m->next++ % TRIG_MEMO;
-    m->arg[j] = a;
-    interval_sincos(x, &m->s[j], &m->c[j], flags);
+    int miss;
+    const unsigned j = trig_memo_find(&m->k, a, &miss);
+    if (miss)
+        point_sincos_lanes(x, n, m->s[j], m->c[j]);
     return j;
 }
 
