@@ -496,6 +496,38 @@ static void exact_workers_free(frame_sync *sy, const frame_job *job)
     free(sy->exact);
 }
 
+void frame_keep_free(frame_keep *k)
+{
+    shadow_map_cache_free(&k->maps);
+    frame_border_free(k->border, k->border_tiles);
+    free(k->border_hit);
+    k->border = NULL;
+    k->border_hit = NULL;
+    k->border_tiles = 0;
+}
+
+/* Border probes for ntiles tiles in k: those kept when there are enough
+ * (every probe is written before it is read), else made anew. -1 (none
+ * kept) when the memory cannot be had. */
+static int keep_border(frame_keep *k, size_t ntiles)
+{
+    if (k->border && k->border_tiles >= ntiles)
+        return 0;
+    frame_border_free(k->border, k->border_tiles);
+    free(k->border_hit);
+    k->border = frame_border_alloc(ntiles);
+    k->border_hit = malloc(ntiles ? ntiles : 1);
+    k->border_tiles = ntiles;
+    if (k->border && k->border_hit)
+        return 0;
+    frame_border_free(k->border, ntiles);
+    free(k->border_hit);
+    k->border = NULL;
+    k->border_hit = NULL;
+    k->border_tiles = 0;
+    return -1;
+}
+
 int frame_render(const frame_job *job, frame_stats *stats)
 {
     pthread_once(&srgb_once, srgb_init);
@@ -519,25 +551,23 @@ int frame_render(const frame_job *job, frame_stats *stats)
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     const size_t ntiles = (size_t)sh.tiles_x * sh.tiles_y;
     int rc = 0;
-    shadow_map_cache own_maps = {0};
-    shadow_map_cache *maps = job->shadow_maps ? job->shadow_maps : &own_maps;
+    frame_keep own = {0};
+    frame_keep *keep = job->keep ? job->keep : &own;
     if (job->shade.shadows) {
         /* made before the passes on all the threads (or kept from the last
            frame): its time is the shadow rays' */
         const double t0 = job->timing ? frame_now_ns() : 0.0;
         int built;
-        sh.shadow_map = shadow_map_cached(maps, job->tree, job->shade.light, job->threads, &built);
+        sh.shadow_map =
+            shadow_map_cached(&keep->maps, job->tree, job->shade.light, job->threads, &built);
         if (job->timing && built)
             sy.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
     }
     if (job->aa > 1) {
-        sh.border = frame_border_alloc(ntiles);
-        sh.border_hit = malloc(ntiles ? ntiles : 1);
-        if (!sh.border || !sh.border_hit) {
-            frame_border_free(sh.border, ntiles);
-            free(sh.border_hit);
-            sh.border = NULL;
-            sh.border_hit = NULL;
+        if (keep_border(keep, ntiles) == 0) {
+            sh.border = keep->border;
+            sh.border_hit = keep->border_hit;
+        } else {
             rc = ENOMEM; /* one ray a pixel */
         }
     }
@@ -547,9 +577,7 @@ int frame_render(const frame_job *job, frame_stats *stats)
         if (!rc1)
             rc1 = rc2;
     }
-    frame_border_free(sh.border, ntiles);
-    free(sh.border_hit);
-    shadow_map_cache_free(&own_maps);
+    frame_keep_free(&own);
     exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;

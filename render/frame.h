@@ -12,6 +12,7 @@
 #include "render/aa.h"
 #include "render/exact_scene.h"
 #include "render/shade.h"
+#include "render/shadow_map.h"
 #include "render/trace.h"
 #include "render/trace_impl.h"
 
@@ -41,15 +42,28 @@ typedef struct frame_job {
     int no_packets;     /* 1: every antialiasing sample traced alone, not in
                            packets (trace_packet.h; tests compare the two) */
     trace_traverse_fn traverse; /* NULL: the build's preferred implementation */
-    struct shadow_map_cache *shadow_maps; /* with shadows: the map kept from frame to
-                                             frame (shadow_map.h); NULL: made and
-                                             freed in each frame */
+    struct frame_keep *keep; /* what is kept from frame to frame; NULL: all made and
+                                freed in the frame */
     int timing;         /* 1: time the secondary rays apart (frame_stats) */
     /* Called by the calling thread after each tile it finishes, with tiles
      * done so far and the total; may be NULL. */
     void (*progress)(void *ctx, uint64_t done, uint64_t total);
     void *progress_ctx;
 } frame_job;
+
+/* What a run of frames keeps from one to the next (render's views loop):
+ * the light's shadow map, made again only for another light
+ * (shadow_map_cached), and the antialiasing pass's tile border probes,
+ * grown as the images do (a mapping made anew each frame costs a page
+ * fault a page). Zeroed to start; frame_keep_free at the end. */
+typedef struct frame_keep {
+    shadow_map_cache maps;
+    aa_probe *border;      /* border_tiles tiles' probes, or NULL */
+    uint8_t *border_hit;   /* a byte a tile */
+    size_t border_tiles;
+} frame_keep;
+
+void frame_keep_free(frame_keep *k);
 
 typedef struct frame_stats {
     uint64_t rays, hits, steps; /* primary rays (centre rays and samples), centre rays

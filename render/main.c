@@ -26,7 +26,6 @@
 #include "render/map_guard.h"
 #include "render/outputs.h"
 #include "render/shade.h"
-#include "render/shadow_map.h"
 #include "render/trace.h"
 #include "render/view_report.h"
 #include "render/views.h"
@@ -403,7 +402,7 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
  * totals. Returns EXIT_OK or EXIT_RUNTIME. */
 static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
                        const camera *cam, const render_buffers *buf, const exact_scene *es,
-                       shadow_map_cache *maps, double *total_ms, uint64_t *total_rays)
+                       frame_keep *keep, double *total_ms, uint64_t *total_rays)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
@@ -428,7 +427,7 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     job.aa = (unsigned)v->aa;
     job.alpha = v->alpha ? buf->alpha : NULL;
     job.shade.shadows = v->shadows;
-    job.shadow_maps = maps;
+    job.keep = keep;
     job.shade.ao_rays = (unsigned)v->ao;
     job.timing = o->verbose;
     if (!o->quiet && diag_stderr_is_tty())
@@ -474,21 +473,21 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
     uint64_t total_rays = 0;
     size_t first = o->part_count ? (size_t)o->part_index : 0, step = o->part_count ? (size_t)o->part_count : 1;
     size_t done = 0;
-    shadow_map_cache maps = {0}; /* one map for the views under one light */
+    frame_keep keep = {0}; /* the shadow map and the border probes, view to view */
     for (size_t k = first; k < nviews; k += step, done++) {
         test_hooks_view((unsigned)k + 1);
         int st = EXIT_RUNTIME;
         if (map_guard_changed())
             diag_path_error(o->oct_path, "changed while being read");
         else
-            st = render_view(tree, o, &list[k], &cams[k], buf, es, &maps, &total_ms,
+            st = render_view(tree, o, &list[k], &cams[k], buf, es, &keep, &total_ms,
                              &total_rays);
         if (st != EXIT_OK) {
-            shadow_map_cache_free(&maps);
+            frame_keep_free(&keep);
             return st;
         }
     }
-    shadow_map_cache_free(&maps);
+    frame_keep_free(&keep);
     if (!o->quiet && o->part_count)
         fprintf(stderr, "render: part %ld/%ld: %zu of %zu views\n", o->part_index, o->part_count, done,
                 nviews);

@@ -62,8 +62,9 @@ static double disc_cover(const camera *cam, double rho, uint32_t i, uint32_t j)
     return (double)in / (k * k);
 }
 
-static void render(const scene *s, unsigned aa, int refine, trace_traverse_fn fn,
-                   unsigned threads, uint8_t *rgb, uint8_t *alpha, float *depth, frame_stats *st)
+static void render_kept(const scene *s, unsigned aa, int refine, trace_traverse_fn fn,
+                        unsigned threads, frame_keep *keep, uint8_t *rgb, uint8_t *alpha,
+                        float *depth, frame_stats *st)
 {
     frame_job job;
     memset(&job, 0, sizeof job);
@@ -80,7 +81,14 @@ static void render(const scene *s, unsigned aa, int refine, trace_traverse_fn fn
     job.beam_size = FRAME_BEAM_DEFAULT;
     job.traverse = fn;
     job.aa = aa;
+    job.keep = keep;
     assert_int_equal(frame_render(&job, st), 0);
+}
+
+static void render(const scene *s, unsigned aa, int refine, trace_traverse_fn fn,
+                   unsigned threads, uint8_t *rgb, uint8_t *alpha, float *depth, frame_stats *st)
+{
+    render_kept(s, aa, refine, fn, threads, NULL, rgb, alpha, depth, st);
 }
 
 static void test_coverage_matches_disc(void **state)
@@ -495,6 +503,42 @@ static void test_packets_same_image(void **state)
     tree_util_free(sp.tree);
 }
 
+/* Frames of several sizes in turn with one frame_keep (render's views
+ * loop): the border probes kept from a larger frame, or grown for a larger
+ * one, give each frame the bytes of a frame that makes its own. */
+static void test_kept_border_same_frames(void **state)
+{
+    (void)state;
+    scene s = sphere_scene(7, 40.0, 200.0, 40.0);
+    const uint32_t sizes[4][2] = {{W, H}, {3 * W, 2 * H}, {W / 2, H}, {3 * W, 2 * H}};
+    const size_t most = (size_t)3 * W * 2 * H;
+    uint8_t *rgb = malloc(most * 3), *ref = malloc(most * 3), *alpha = malloc(most),
+            *aref = malloc(most);
+    assert_true(rgb && ref && alpha && aref);
+    frame_keep keep;
+    memset(&keep, 0, sizeof keep);
+    const double eye[3] = {64, 64, 264}, target[3] = {64, 64, 64}, up[3] = {0, 1, 0};
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(camera_init(&s.cam, eye, target, up, 40.0, sizes[k][0], sizes[k][1]),
+                         CAMERA_OK);
+        const size_t px = (size_t)sizes[k][0] * sizes[k][1];
+        frame_stats st;
+        render(&s, 4, 0, NULL, 2, ref, aref, NULL, &st);
+        assert_true(st.aa_pixels > 0);
+        render_kept(&s, 4, 0, NULL, 2, &keep, rgb, alpha, NULL, &st);
+        assert_memory_equal(rgb, ref, px * 3);
+        assert_memory_equal(alpha, aref, px);
+        assert_non_null(keep.border);
+    }
+    frame_keep_free(&keep);
+    assert_null(keep.border);
+    free(rgb);
+    free(ref);
+    free(alpha);
+    free(aref);
+    tree_util_free(s.tree);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -506,6 +550,7 @@ int main(void)
         cmocka_unit_test(test_beam_edge_trigger),
         cmocka_unit_test(test_sample_starts_exact),
         cmocka_unit_test(test_packets_same_image),
+        cmocka_unit_test(test_kept_border_same_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -29,7 +29,7 @@
 static const double ball_c[3] = {64, 64, 70}, ball_r = 20;
 
 static void render_kept(const oct_tree *t, const camera *cam, const double light[3], int refine,
-                        trace_traverse_fn fn, unsigned threads, shadow_map_cache *maps,
+                        trace_traverse_fn fn, unsigned threads, frame_keep *keep,
                         uint8_t *rgb, float *depth)
 {
     frame_job job;
@@ -46,7 +46,7 @@ static void render_kept(const oct_tree *t, const camera *cam, const double light
     job.threads = threads;
     job.beam_size = FRAME_BEAM_DEFAULT;
     job.traverse = fn;
-    job.shadow_maps = maps;
+    job.keep = keep;
     frame_stats st;
     assert_int_equal(frame_render(&job, &st), 0);
     assert_true(st.shadow_rays > 0);
@@ -141,7 +141,7 @@ static void test_ball_shadow_on_slab(void **state)
 }
 
 /* Views under two lights in turn, one map kept from frame to frame
- * (frame_job.shadow_maps, as render's views loop keeps it): each frame the
+ * (frame_job.keep, as render's views loop keeps it): each frame the
  * same bytes as a frame that makes its own map, and the two lights' images
  * differ. (That the kept map is remade for a new light is
  * test_shadow_map's test_cache_follows_tree_and_light.) */
@@ -154,19 +154,19 @@ static void test_kept_map_same_frames(void **state)
     uint8_t *rgb = malloc(W * W * 3), *ref = malloc(W * W * 3), *first = malloc(W * W * 3);
     float *depth = malloc(W * W * sizeof *depth);
     assert_true(rgb && ref && first && depth);
-    shadow_map_cache maps;
-    memset(&maps, 0, sizeof maps);
+    frame_keep keep;
+    memset(&keep, 0, sizeof keep);
     for (int k = 0; k < 3; k++) {
         render(t, &cam, lights[k], 0, NULL, 2, ref, depth);
-        render_kept(t, &cam, lights[k], 0, NULL, 2, &maps, rgb, depth);
+        render_kept(t, &cam, lights[k], 0, NULL, 2, &keep, rgb, depth);
         assert_memory_equal(rgb, ref, W * W * 3);
-        assert_non_null(maps.tree);
+        assert_non_null(keep.maps.tree);
         if (k == 0)
             memcpy(first, rgb, W * W * 3);
         else
             assert_true((memcmp(first, rgb, W * W * 3) == 0) == (k == 2));
     }
-    shadow_map_cache_free(&maps);
+    frame_keep_free(&keep);
     free(rgb);
     free(ref);
     free(first);
