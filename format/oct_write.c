@@ -10,10 +10,10 @@
 #include <stdlib.h>
 #include <zlib.h>
 
-/* Bytes kept in chunks of STORE_CHUNK bytes: appending never moves what is stored. (A
- * doubling realloc of hundreds of megabytes copies them on some systems and
- * on others moves their pages, which a virtual machine may then fault in
- * again one by one when they are next read: docs/perf-log.md.) */
+/* Bytes kept in chunks of STORE_CHUNK bytes: appending never moves what is
+ * stored. (A doubling realloc of hundreds of megabytes copies them on some
+ * systems and on others moves their pages, which a virtual machine may then
+ * fault in again one by one when they are next read: docs/perf-log.md.) */
 #define STORE_BITS 22
 #define STORE_CHUNK ((size_t)1 << STORE_BITS)
 typedef struct chunked {
