@@ -1,6 +1,7 @@
 /* oct_sink: the byte sink of the .oct writer and of the merge. Every byte
  * written goes through it: it keeps the running CRC-32 and the count, and
- * writes to a stream when it has one (none: a checksum-only pass). */
+ * writes to a stream when it has one (none: a checksum-only pass; no_crc: a
+ * pass whose CRCs are known already). */
 #ifndef OCT_SINK_H
 #define OCT_SINK_H
 

@@ -496,14 +496,19 @@ static void exact_workers_free(frame_sync *sy, const frame_job *job)
     free(sy->exact);
 }
 
-void frame_keep_free(frame_keep *k)
+static void border_free(frame_keep *k)
 {
-    shadow_map_cache_free(&k->maps);
     frame_border_free(k->border, k->border_tiles);
     free(k->border_hit);
     k->border = NULL;
     k->border_hit = NULL;
     k->border_tiles = 0;
+}
+
+void frame_keep_free(frame_keep *k)
+{
+    shadow_map_cache_free(&k->maps);
+    border_free(k);
 }
 
 /* Border probes for ntiles tiles in k: those kept when there are enough
@@ -513,18 +518,13 @@ static int keep_border(frame_keep *k, size_t ntiles)
 {
     if (k->border && k->border_tiles >= ntiles)
         return 0;
-    frame_border_free(k->border, k->border_tiles);
-    free(k->border_hit);
+    border_free(k);
     k->border = frame_border_alloc(ntiles);
     k->border_hit = malloc(ntiles ? ntiles : 1);
     k->border_tiles = ntiles;
     if (k->border && k->border_hit)
         return 0;
-    frame_border_free(k->border, ntiles);
-    free(k->border_hit);
-    k->border = NULL;
-    k->border_hit = NULL;
-    k->border_tiles = 0;
+    border_free(k);
     return -1;
 }
 

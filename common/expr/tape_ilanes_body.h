@@ -175,14 +175,12 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
          * argument has an earlier lane's bits (a cell's children share
          * each coordinate in halves) takes that lane's results and flags. */
         double mid[W], sm[W], cm[W];
-        unsigned narrow = 0, copy = 0, same[W], lf[W];
+        unsigned narrow = 0, same[W], lf[W];
         for (unsigned l = 0; l < n; l++) {
             same[l] = il_first_same(a, l);
             lf[l] = 0;
-            if (same[l] < l) {
-                copy |= 1u << l;
+            if (same[l] < l)
                 continue;
-            }
             interval x = il_get(a, l);
             if (interval__sincos_narrow(x)) {
                 narrow |= 1u << l;
@@ -206,7 +204,7 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
                 il_set(&m->c[j], l, interval__sincos_form(cm[l], sm[l], h, q));
             }
         for (unsigned l = 0; l < n; l++)
-            if (copy >> l & 1) {
+            if (same[l] < l) {
                 const unsigned e = same[l];
                 il_set(&m->s[j], l, il_get(&m->s[j], e));
                 il_set(&m->c[j], l, il_get(&m->c[j], e));
