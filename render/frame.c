@@ -139,6 +139,13 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
         for (int a = 0; a < 3; a++)
             p[a] = job->cam->eye[a] + h->t * dir[a];
         shadow_start *const st = &acc->start;
+        if (shadow && !ao_count && sh->shadow_map &&
+            (h->exact ? shadow_lit_at(job->tree, p, n, sh->shadow_map, job->shade.light)
+                      : shadow_lit_stored(job->tree, h, ns, n, sh->shadow_map,
+                                          job->shade.light))) {
+            acc->shadow_rays++; /* answered by the map where it starts */
+            goto lit;
+        }
         if (!(h->exact ? shadow_start_at(job->tree, p, n, st)
                        : shadow_start_stored(job->tree, h, ns, n, st)))
             goto lit; /* no start off the surface: lit and open */
@@ -559,7 +566,10 @@ int frame_render(const frame_job *job, frame_stats *stats)
         const double t0 = job->timing ? frame_now_ns() : 0.0;
         int built;
         sh.shadow_map =
-            shadow_map_cached(&keep->maps, job->tree, job->shade.light, job->threads, &built);
+            shadow_map_cached(&keep->maps, job->tree, job->shade.light,
+                              shadow_map_up_for(job->tree, job->shadow_pixels ? job->shadow_pixels
+                                                                              : npx),
+                              job->threads, &built);
         if (job->timing && built)
             sy.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
     }

@@ -44,6 +44,9 @@ typedef struct frame_job {
     trace_traverse_fn traverse; /* NULL: the build's preferred implementation */
     struct frame_keep *keep; /* what is kept from frame to frame; NULL: all made and
                                 freed in the frame */
+    uint64_t shadow_pixels; /* with shadows: the pixels of this frame and of the frames
+                               to come under the same light, whose rays the shadow map
+                               will serve (shadow_map_up_for); 0: this frame's */
     int timing;         /* 1: time the secondary rays apart (frame_stats) */
     /* Called by the calling thread after each tile it finishes, with tiles
      * done so far and the total; may be NULL. */

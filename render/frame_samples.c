@@ -7,43 +7,21 @@
 
 #include <math.h>
 #include <stdlib.h>
-#include <sys/mman.h>
 
+#include "common/big_alloc.h"
 #include "render/beam.h"
 #include "render/trace_packet.h"
-
-/* The border probes of a megapixel are 3 MB, whose first touch costs some
- * 750 page faults: large ones are mapped asking for huge pages. */
-#define BORDER_MAPPED (UINT64_C(1) << 21)
 
 aa_probe *frame_border_alloc(size_t n)
 {
     if (n > SIZE_MAX / (FRAME_BORDER * sizeof(aa_probe)))
         return NULL;
-    const size_t bytes = n * FRAME_BORDER * sizeof(aa_probe);
-#if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
-    if (bytes >= BORDER_MAPPED) {
-        void *p = mmap(NULL, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        if (p == MAP_FAILED)
-            return NULL;
-        (void)madvise(p, bytes, MADV_HUGEPAGE); /* a hint: no huge pages is fine */
-        return p;
-    }
-#endif
-    return malloc(bytes ? bytes : 1);
+    return big_alloc(n * FRAME_BORDER * sizeof(aa_probe)); /* a megapixel's are 3 MB */
 }
 
 void frame_border_free(aa_probe *p, size_t n)
 {
-    if (!p)
-        return;
-#if defined(MAP_ANONYMOUS) && defined(MADV_HUGEPAGE)
-    if (n * FRAME_BORDER * sizeof(aa_probe) >= BORDER_MAPPED) {
-        munmap(p, n * FRAME_BORDER * sizeof(aa_probe));
-        return;
-    }
-#endif
-    free(p);
+    big_free(p, n * FRAME_BORDER * sizeof(aa_probe));
 }
 
 /* Where the samples of the pixel of centre probe c may start (+inf: they

@@ -30,10 +30,17 @@ static int voxel_occupied(const oct_tree *tree, const double g[3], shadow_start 
     return (int)(an->node[an->depth].mask >> c & 1u);
 }
 
-/* The start point from base (grid units, on the surface) along n, moved
- * on out of occupied voxels (shadow_origin). The anchor of the box around
- * the start also holds s->eye.o, which is within rounding of g: it is the
- * rays' anchor. */
+/* Try k of the start point from base (grid units, on the surface) along n. */
+static void start_grid(const double base[3], const float n[3], unsigned k, double g[3])
+{
+    const double h = shadow_offset(n) + (double)k;
+    for (int a = 0; a < 3; a++)
+        g[a] = base[a] + h * (double)n[a];
+}
+
+/* The start point from base along n, moved on out of occupied voxels
+ * (shadow_origin). The anchor of the box around the start also holds
+ * s->eye.o, which is within rounding of g: it is the rays' anchor. */
 static int start_from(const oct_tree *tree, const double base[3], const float n[3],
                       shadow_start *s)
 {
@@ -42,9 +49,7 @@ static int start_from(const oct_tree *tree, const double base[3], const float n[
     const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double g[3];
     for (unsigned k = 0; k < SHADOW_TRIES; k++) {
-        const double h = shadow_offset(n) + (double)k;
-        for (int a = 0; a < 3; a++)
-            g[a] = base[a] + h * (double)n[a];
+        start_grid(base, n, k, g);
         if (!voxel_occupied(tree, g, s)) {
             for (int a = 0; a < 3; a++)
                 s->o[a] = tree->origin[a] + g[a] * vox;
@@ -53,6 +58,24 @@ static int start_from(const oct_tree *tree, const double base[3], const float n[
         }
     }
     return 0;
+}
+
+/* The hit voxel's plane point nearest its centre, grid units. */
+static void stored_base(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                        double base[3])
+{
+    const uint32_t rec = tree->voxels[hit->voxel];
+    const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
+    for (int a = 0; a < 3; a++)
+        base[a] = (double)hit->xyz[a] + 0.5 + off * (double)ns[a];
+}
+
+/* A world point p in grid units. */
+static void grid_of(const oct_tree *tree, const double p[3], double base[3])
+{
+    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
+    for (int a = 0; a < 3; a++)
+        base[a] = (p[a] - tree->origin[a]) / vox;
 }
 
 int shadow_start_hit(const oct_tree *tree, const trace_hit *hit, const float n[3], shadow_start *s)
@@ -65,21 +88,63 @@ int shadow_start_hit(const oct_tree *tree, const trace_hit *hit, const float n[3
 int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
                         const float n[3], shadow_start *s)
 {
-    const uint32_t rec = tree->voxels[hit->voxel];
-    const double off = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT));
     double base[3];
-    for (int a = 0; a < 3; a++)
-        base[a] = (double)hit->xyz[a] + 0.5 + off * (double)ns[a];
+    stored_base(tree, hit, ns, base);
     return start_from(tree, base, n, s);
 }
 
 int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s)
 {
-    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double base[3];
-    for (int a = 0; a < 3; a++)
-        base[a] = (p[a] - tree->origin[a]) / vox;
+    grid_of(tree, p, base);
     return start_from(tree, base, n, s);
+}
+
+/* shadow_lit_stored and shadow_lit_at from base. The first start point,
+ * taken to the world and back as start_from and trace_eye_init do (the
+ * same bits as the eye's grid position there), asked of the map: past
+ * every occupied cell there, it is in no occupied voxel either (the map
+ * raises its texel above every point of one), so start_from would take it
+ * and shadow_blocked_from would answer lit from the same query. */
+static int lit_from(const oct_tree *tree, const double base[3], const float n[3],
+                    const shadow_map *map, const double light[3])
+{
+    const double nvox = (double)(UINT32_C(1) << tree->levels);
+    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
+    const double scale = nvox / tree->edge;
+    double g[3];
+    start_grid(base, n, 0, g);
+    for (int a = 0; a < 3; a++)
+        g[a] = (tree->origin[a] + g[a] * vox - tree->origin[a]) * scale;
+    return shadow_map_clear_t(map, g, light, scale) <= 0.0;
+}
+
+/* 1 when a map can answer where the rays start: one of voxel cells (the
+ * texels of coarser cells nearly always reach above a point 2 voxels off
+ * the surface, docs/perf-log.md). */
+static int map_of_voxels(const oct_tree *tree, const shadow_map *map)
+{
+    return map && map->depth == tree->levels;
+}
+
+int shadow_lit_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                      const float n[3], const shadow_map *map, const double light[3])
+{
+    if (!map_of_voxels(tree, map))
+        return 0;
+    double base[3];
+    stored_base(tree, hit, ns, base);
+    return lit_from(tree, base, n, map, light);
+}
+
+int shadow_lit_at(const oct_tree *tree, const double p[3], const float n[3],
+                  const shadow_map *map, const double light[3])
+{
+    if (!map_of_voxels(tree, map))
+        return 0;
+    double base[3];
+    grid_of(tree, p, base);
+    return lit_from(tree, base, n, map, light);
 }
 
 int shadow_origin(const oct_tree *tree, const trace_hit *hit, const float n[3], double o[3])

@@ -75,6 +75,17 @@ int shadow_start_stored(const oct_tree *tree, const trace_hit *hit, const float 
                         const float n[3], shadow_start *s);
 int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], shadow_start *s);
 
+/* 1 when the map of `light` (made for it, of voxel cells: SHADOW_MAP_FINE
+ * and at most SHADOW_MAP_MAX_DEPTH levels; else, or NULL: 0) says that a
+ * hit's shadow ray is lit from where it would start: what
+ * shadow_start_stored (or shadow_start_at) and shadow_blocked_from with
+ * that map would answer, without the start's search and set-up; 0: not
+ * known so. For a shadow ray alone (AO rays need the start). */
+int shadow_lit_stored(const oct_tree *tree, const trace_hit *hit, const float ns[3],
+                      const float n[3], const shadow_map *map, const double light[3]);
+int shadow_lit_at(const oct_tree *tree, const double p[3], const float n[3],
+                  const shadow_map *map, const double light[3]);
+
 /* The any-hit walk shadow_cast uses for opts and traverse (under the paper's
  * rule: traverse's implementation's), or NULL: the full traversal. */
 trace_occluded_fn shadow_any_hit(const trace_opts *opts, trace_traverse_fn traverse);

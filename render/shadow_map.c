@@ -7,11 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/big_alloc.h"
 #include "render/basis.h"
 
-/* The map's cells are no deeper than this: under 900 texels a side
- * (a 2^9 grid's projection) whatever the levels. */
-#define SHADOW_MAP_MAX_DEPTH 9
 /* The depth of the subtrees the threads take one at a time (at most 512). */
 #define SPLIT_DEPTH 3
 
@@ -31,64 +29,62 @@ typedef struct build_ctx {
     const oct_tree *tree;
     const shadow_map *m;
     unsigned depth;           /* of the map's cells */
-    struct {
-        double lo[2], hi[2];  /* a cell's texel range: corner . u (v) / texel + these */
-        double top;           /* its greatest height: corner . w + this */
-    } box[256];               /* by the cell's mask of children: the boxes of its
-                                 occupied children, grown by the margin */
-    double child[SHADOW_MAP_MAX_DEPTH + 1][8][3]; /* child k's corner offset at depth d + 1,
+    double child[SHADOW_MAP_MAX_DEPTH][8][3]; /* child k's corner offset at depth d + 1,
                                                  projected: the corner's, summed on the way
                                                  down (one rounding a level, far under
                                                  the margin) */
-    map_node *split;          /* the nodes of depth min(SPLIT_DEPTH, depth) */
+    double centre[8][3];      /* a cell's centre from its parent's corner, projected,
+                                 u and v in texels from the plane's origin */
+    struct {
+        double lo[2], hi[2];  /* a cell's box across the light from its centre, in
+                                 texels (within 0.87 of it) */
+        double top;           /* its greatest height from its centre's */
+    } box[256];               /* by the cell's mask of children (a cell of voxels:
+                                 255): its occupied children's corners, grown by
+                                 the margin */
+    map_node *split;          /* the nodes of depth min(SPLIT_DEPTH, depth - 1) */
     size_t nsplit;
     atomic_size_t next;       /* the next of them to take */
 } build_ctx;
 
-/* floor(x) clamped to [0, n - 1] (x >= 0 but for the margin); branch-free
- * (a NaN gives 0). */
-static uint32_t texel(double x, uint32_t n)
+/* The cells of a parent of cells (corner projections p, its children
+ * `ch`) into top: each raises the texels its box (c->box) meets to its
+ * greatest height (rounded to nearest; finish adds the rest). A box lies
+ * inside the cube's projection grown by the margin, which the map holds
+ * with a grid unit (at least a texel) to spare on each side, and two
+ * texels more after the last: its 3x3 texels need no clamp. */
+static void put_cells_of(const build_ctx *c, float *top, const double p[3], oct_children ch)
 {
-    const double top = (double)(n - 1u);
-    x = x > 0.0 ? x : 0.0;
-    return (uint32_t)(x < top ? x : top);
-}
-
-/* x (finite or -inf) as a float no smaller than x. */
-static float float_up(double x)
-{
-    float f = (float)x;
-    if ((double)f < x) { /* rounded down: one step up, by its bits */
-        uint32_t b;
-        memcpy(&b, &f, sizeof b);
-        if (f > 0.0f)
-            b++;
-        else if (f < 0.0f)
-            b--;
-        else
-            b = 1u; /* the least subnormal */
-        memcpy(&f, &b, sizeof f);
-    }
-    return f;
-}
-
-static void put_cell(const build_ctx *c, float *top, const double p[3], unsigned mask)
-{
-    const shadow_map *m = c->m;
-    const float f = float_up(p[2] + c->box[mask].top);
-    const double su = p[0] * m->inv_texel, sv = p[1] * m->inv_texel;
-    const double *lo = c->box[mask].lo, *hi = c->box[mask].hi;
-    const uint32_t i0 = texel(su + lo[0], m->nu), i1 = texel(su + hi[0], m->nu);
-    const uint32_t j0 = texel(sv + lo[1], m->nv), j1 = texel(sv + hi[1], m->nv);
-    for (uint32_t j = j0; j <= j1; j++) {
-        float *row = &top[(size_t)j * m->nu];
-        for (uint32_t i = i0; i <= i1; i++)
-            row[i] = f > row[i] ? f : row[i]; /* maxss: no branch to mispredict */
+    const size_t nu = c->m->nu;
+    const double su = p[0] * c->m->inv_texel, sv = p[1] * c->m->inv_texel;
+    const int voxels = c->depth == c->tree->levels;
+    uint64_t index = ch.first;
+    for (unsigned mask = ch.mask; mask; mask &= mask - 1u, index++) {
+        const unsigned k = (unsigned)__builtin_ctz(mask);
+        const unsigned cm = voxels ? 255u : oct_node_children(c->tree->groups[c->depth], index).mask;
+        const double cu = su + c->centre[k][0], cv = sv + c->centre[k][1];
+        const size_t i0 = (size_t)(int64_t)(cu + c->box[cm].lo[0]);
+        const size_t i1 = (size_t)(int64_t)(cu + c->box[cm].hi[0]);
+        const size_t j0 = (size_t)(int64_t)(cv + c->box[cm].lo[1]);
+        const size_t j1 = (size_t)(int64_t)(cv + c->box[cm].hi[1]);
+        const float f = (float)(p[2] + c->centre[k][2] + c->box[cm].top);
+        /* one to three texels each way: a 3x3 block raised without a branch,
+           by -inf where the box ends short */
+        const float col[3] = {f, i1 > i0 ? f : -INFINITY, i1 > i0 + 1u ? f : -INFINITY};
+        const float row[3] = {f, j1 > j0 ? f : -INFINITY, j1 > j0 + 1u ? f : -INFINITY};
+        float *t = &top[j0 * nu + i0];
+#pragma GCC unroll 3
+        for (int r = 0; r < 3; r++, t += nu)
+#pragma GCC unroll 3
+            for (int q = 0; q < 3; q++) {
+                const float x = col[q] < row[r] ? col[q] : row[r];
+                t[q] = x > t[q] ? x : t[q]; /* maxss */
+            }
     }
 }
 
 /* Where a walk puts what it reaches at its stop depth: the nodes into list
- * (the threads' subtrees), or, list NULL, the cells into top. */
+ * (the threads' subtrees), or, list NULL, their cells into top. */
 typedef struct walk_out {
     float *top;
     map_node *list;
@@ -105,7 +101,7 @@ static void walk(const build_ctx *c, walk_out *out, unsigned d, unsigned stop,
     }
     const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
     if (d == stop) {
-        put_cell(c, out->top, n->p, ch.mask);
+        put_cells_of(c, out->top, n->p, ch);
         return;
     }
     map_node k;
@@ -125,23 +121,28 @@ typedef struct build_worker {
     float *top;
 } build_worker;
 
+static unsigned split_depth(const build_ctx *c)
+{
+    return c->depth - 1u < SPLIT_DEPTH ? c->depth - 1u : SPLIT_DEPTH;
+}
+
 static void *build_run(void *arg)
 {
     const build_worker *w = arg;
     build_ctx *c = w->c;
-    const unsigned d = c->depth < SPLIT_DEPTH ? c->depth : SPLIT_DEPTH;
     for (;;) {
         const size_t k = atomic_fetch_add(&c->next, 1);
         if (k >= c->nsplit)
             return NULL;
         walk_out out = {w->top, NULL, 0};
-        walk(c, &out, d, c->depth, &c->split[k]);
+        walk(c, &out, split_depth(c), c->depth - 1u, &c->split[k]);
     }
 }
 
+/* A map's texels, all -inf (a megabyte or more: big_alloc's). */
 static float *empty_map(size_t texels)
 {
-    float *t = malloc(texels * sizeof *t);
+    float *t = texels <= SIZE_MAX / sizeof *t ? big_alloc(texels * sizeof *t) : NULL;
     for (size_t k = 0; t && k < texels; k++)
         t[k] = -INFINITY;
     return t;
@@ -152,7 +153,7 @@ static int put_cells(build_ctx *c, unsigned threads)
 {
     const shadow_map *m = c->m;
     const size_t texels = (size_t)m->nu * m->nv;
-    const unsigned d = c->depth < SPLIT_DEPTH ? c->depth : SPLIT_DEPTH;
+    const unsigned d = split_depth(c);
     c->split = malloc(((size_t)1 << (3 * d)) * sizeof *c->split);
     if (!c->split)
         return -1;
@@ -174,7 +175,7 @@ static int put_cells(build_ctx *c, unsigned threads)
         if (!w[started].top)
             break;
         if (pthread_create(&tid[started], NULL, build_run, &w[started]) != 0) {
-            free(w[started].top);
+            big_free(w[started].top, texels * sizeof *w[started].top);
             break; /* the started threads and this one do the rest */
         }
     }
@@ -183,15 +184,50 @@ static int put_cells(build_ctx *c, unsigned threads)
         pthread_join(tid[t], NULL);
         const float *src = w[t].top;
         for (size_t k = 0; k < texels; k++)
-            if (m->top[k] < src[k])
-                m->top[k] = src[k];
-        free(w[t].top);
+            m->top[k] = src[k] > m->top[k] ? src[k] : m->top[k];
+        big_free(w[t].top, texels * sizeof *src);
     }
     free(c->split);
     return 0;
 }
 
-int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threads,
+/* The least float above f (finite), by its bits. */
+static float float_next_up(float f)
+{
+    uint32_t b;
+    memcpy(&b, &f, sizeof b);
+    if (f > 0.0f)
+        b++;
+    else if (f < 0.0f)
+        b--;
+    else
+        b = 1u; /* the least subnormal */
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+/* The texels' heights, rounded to nearest, one float step up: no lower
+ * than the heights they were rounded from. */
+static void finish(shadow_map *m)
+{
+    float *t = m->top;
+    for (size_t k = 0, n = (size_t)m->nu * m->nv; k < n; k++)
+        if (t[k] != -INFINITY)
+            t[k] = float_next_up(t[k]);
+}
+
+unsigned shadow_map_depth(const oct_tree *tree, unsigned up)
+{
+    const unsigned d = tree->levels > up ? tree->levels - up : 1u;
+    return d < SHADOW_MAP_MAX_DEPTH ? d : SHADOW_MAP_MAX_DEPTH;
+}
+
+unsigned shadow_map_up_for(const oct_tree *tree, uint64_t pixels)
+{
+    return pixels >= 2u * tree->voxel_count ? SHADOW_MAP_FINE : SHADOW_MAP_COARSE;
+}
+
+int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, unsigned threads,
                      shadow_map *m)
 {
     for (int a = 0; a < 3; a++)
@@ -206,9 +242,8 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
     build_ctx c;
     c.tree = tree;
     c.m = m;
-    c.depth = levels > SHADOW_MAP_UP ? levels - SHADOW_MAP_UP : 0;
-    if (c.depth > SHADOW_MAP_MAX_DEPTH)
-        c.depth = SHADOW_MAP_MAX_DEPTH;
+    c.depth = shadow_map_depth(tree, up);
+    m->depth = c.depth;
     const double side = (double)(UINT32_C(1) << (levels - c.depth));
     const double n = (double)(UINT32_C(1) << levels);
     /* the cube's projection, one grid unit wider on each side than its
@@ -225,13 +260,13 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
     m->u0 = ulo - 1.0;
     m->v0 = vlo - 1.0;
     m->inv_texel = 1.0 / side;
-    m->nu = (uint32_t)((uhi + 1.0 - m->u0) * m->inv_texel) + 1u;
-    m->nv = (uint32_t)((vhi + 1.0 - m->v0) * m->inv_texel) + 1u;
+    m->nu = (uint32_t)((uhi + 1.0 - m->u0) * m->inv_texel) + 3u;
+    m->nv = (uint32_t)((vhi + 1.0 - m->v0) * m->inv_texel) + 3u;
     m->top = empty_map((size_t)m->nu * m->nv);
     if (!m->top)
         return -1;
     const double *axes[3] = {m->u, m->v, m->w};
-    for (unsigned d = 0; d <= c.depth; d++) {
+    for (unsigned d = 0; d + 1u < c.depth; d++) {
         const double half = (double)(UINT32_C(1) << (levels - d - 1u));
         for (unsigned k = 0; k < 8; k++)
             for (int p = 0; p < 3; p++) {
@@ -241,9 +276,19 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
                                    (double)(k >> 2 & 1u) * half * ax[2];
             }
     }
-    /* a child's extremes over its corners from its own corner, grown by the
-       margin; a cell's, those of its occupied children, in texels from the
-       plane's origin (the texel side is a power of two: scaling by it is exact) */
+    /* a cell's centre from its parent's corner; u and v from the plane's
+       origin in texels (the texel side is a power of two: scaling by it is
+       exact) */
+    for (unsigned k = 0; k < 8; k++)
+        for (int p = 0; p < 3; p++) {
+            const double *ax = axes[p];
+            const double x = ((double)(k & 1u) + 0.5) * side * ax[0] +
+                             ((double)(k >> 1 & 1u) + 0.5) * side * ax[1] +
+                             ((double)(k >> 2 & 1u) + 0.5) * side * ax[2];
+            c.centre[k][p] = p == 2 ? x : (x - (p ? m->v0 : m->u0)) * m->inv_texel;
+        }
+    /* a child's corners from the cell's centre, at most, grown by the
+       margin; a cell's box, those of its occupied children */
     const double half = side / 2.0;
     double clo[3], chi[3];
     for (int p = 0; p < 3; p++) {
@@ -254,17 +299,21 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
             chi[p] += fmax(0.0, axes[p][a] * half);
         }
     }
-    for (unsigned mask = 0; mask < 256; mask++) {
+    for (unsigned mask = 1; mask < 256; mask++) {
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (unsigned k = 0; k < 8; k++)
             for (int p = 0; mask >> k & 1u && p < 3; p++) {
-                lo[p] = fmin(lo[p], c.child[c.depth][k][p] + clo[p]);
-                hi[p] = fmax(hi[p], c.child[c.depth][k][p] + chi[p]);
+                /* child k's corner from the cell's centre, projected */
+                const double *ax = axes[p];
+                const double o = ((double)(k & 1u) - 1.0) * half * ax[0] +
+                                 ((double)(k >> 1 & 1u) - 1.0) * half * ax[1] +
+                                 ((double)(k >> 2 & 1u) - 1.0) * half * ax[2];
+                lo[p] = fmin(lo[p], o + clo[p]);
+                hi[p] = fmax(hi[p], o + chi[p]);
             }
         for (int p = 0; p < 2; p++) {
-            const double o = p ? m->v0 : m->u0;
-            c.box[mask].lo[p] = (lo[p] - o) * m->inv_texel;
-            c.box[mask].hi[p] = (hi[p] - o) * m->inv_texel;
+            c.box[mask].lo[p] = lo[p] * m->inv_texel;
+            c.box[mask].hi[p] = hi[p] * m->inv_texel;
         }
         c.box[mask].top = hi[2];
     }
@@ -272,24 +321,27 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned threa
         shadow_map_free(m);
         return -1;
     }
+    finish(m);
     return 0;
 }
 
 void shadow_map_free(shadow_map *m)
 {
-    free(m->top);
+    big_free(m->top, (size_t)m->nu * m->nv * sizeof *m->top);
     m->top = NULL;
 }
 
 const shadow_map *shadow_map_cached(shadow_map_cache *c, const oct_tree *tree,
-                                    const double light[3], unsigned threads, int *built)
+                                    const double light[3], unsigned up, unsigned threads,
+                                    int *built)
 {
     *built = 0;
-    if (c->tree == tree && memcmp(c->map.light, light, sizeof c->map.light) == 0)
+    if (c->tree == tree && memcmp(c->map.light, light, sizeof c->map.light) == 0 &&
+        c->map.depth >= shadow_map_depth(tree, up))
         return &c->map;
     shadow_map_cache_free(c);
     *built = 1;
-    if (shadow_map_build(tree, light, threads, &c->map) != 0)
+    if (shadow_map_build(tree, light, up, threads, &c->map) != 0)
         return NULL;
     c->tree = tree;
     return &c->map;

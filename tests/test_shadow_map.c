@@ -13,6 +13,7 @@
 
 #include "bench/rng.h"
 #include "bench/tree_util.h"
+#include "format/oct_normal.h"
 #include "render/shadow.h"
 #include "render/shadow_map.h"
 #include "tests/grid_hits.h"
@@ -47,7 +48,8 @@ static int box_span(const double g[3], const double D[3], const uint32_t v[3], d
 
 /* Every voxel a ray meets, even at one point, is met before the map's
  * time: random trees of 5 and 6 levels (scattered and clustered voxels),
- * lights with and without zero components, starts inside and outside. */
+ * lights with and without zero components, starts inside and outside, maps
+ * of voxels and of cells of 4 voxels. */
 static void test_clear_t_bounds_every_voxel(void **state)
 {
     (void)state;
@@ -64,9 +66,12 @@ static void test_clear_t_bounds_every_voxel(void **state)
             oct_tree *t = tree_util_simple(levels, (const uint32_t(*)[3])xyz, nv);
             assert_non_null(t);
             const double scale = (double)n / t->edge;
-            for (size_t l = 0; l < sizeof lights / sizeof lights[0]; l++) {
-                shadow_map m;
-                assert_int_equal(shadow_map_build(t, lights[l], 1, &m), 0);
+            for (size_t q = 0; q < 2 * sizeof lights / sizeof lights[0]; q++) {
+                shadow_map m; /* each light with cells of voxels and of 4 voxels */
+                const size_t l = q / 2;
+                const unsigned up = q % 2 ? SHADOW_MAP_COARSE : SHADOW_MAP_FINE;
+                assert_int_equal(shadow_map_build(t, lights[l], up, 1, &m), 0);
+                assert_int_equal(m.depth, levels - up);
                 const double D[3] = {scale * lights[l][0], scale * lights[l][1],
                                      scale * lights[l][2]};
                 for (int k = 0; k < 400; k++) {
@@ -106,12 +111,13 @@ static void test_clear_t_bounds_every_voxel(void **state)
         }
     print_message("map: %lu rays meeting voxels, %lu with a finite end, %lu clear from the start\n",
                   met, finite, none);
-    assert_true(met > 2000 && none > 1000);
+    assert_true(met > 4000 && none > 2000);
 }
 
 /* The map is the same whatever the number of threads that build it (each
  * takes whole subtrees into a map of its own, merged by the maximum): bit
- * for bit, on a random tree of 7 levels with more subtrees than threads. */
+ * for bit, on a random tree of 7 levels with more subtrees than threads, at
+ * both resolutions. */
 static void test_same_map_any_threads(void **state)
 {
     (void)state;
@@ -123,31 +129,35 @@ static void test_same_map_any_threads(void **state)
     oct_tree *t = tree_util_simple(LEVELS, (const uint32_t(*)[3])xyz, nv);
     assert_non_null(t);
     const double light[3] = {-0.3, 0.45, 0.84};
-    shadow_map one;
-    assert_int_equal(shadow_map_build(t, light, 1, &one), 0);
-    size_t raised = 0;
-    for (size_t k = 0; k < (size_t)one.nu * one.nv; k++)
-        raised += one.top[k] > -INFINITY;
-    assert_true(raised > (size_t)one.nu * one.nv / 4);
-    for (unsigned threads = 2; threads <= 9; threads += 7) {
-        shadow_map m;
-        assert_int_equal(shadow_map_build(t, light, threads, &m), 0);
-        assert_int_equal(m.nu, one.nu);
-        assert_int_equal(m.nv, one.nv);
-        assert_memory_equal(m.top, one.top, (size_t)one.nu * one.nv * sizeof *one.top);
-        shadow_map_free(&m);
+    for (unsigned up = SHADOW_MAP_FINE; up <= SHADOW_MAP_COARSE; up += 2) {
+        shadow_map one;
+        assert_int_equal(shadow_map_build(t, light, up, 1, &one), 0);
+        size_t raised = 0;
+        for (size_t k = 0; k < (size_t)one.nu * one.nv; k++)
+            raised += one.top[k] > -INFINITY;
+        assert_true(raised > (size_t)one.nu * one.nv / 4);
+        for (unsigned threads = 2; threads <= 9; threads += 7) {
+            shadow_map m;
+            assert_int_equal(shadow_map_build(t, light, up, threads, &m), 0);
+            assert_int_equal(m.nu, one.nu);
+            assert_int_equal(m.nv, one.nv);
+            assert_memory_equal(m.top, one.top, (size_t)one.nu * one.nv * sizeof *one.top);
+            shadow_map_free(&m);
+        }
+        shadow_map_free(&one);
     }
-    shadow_map_free(&one);
     tree_util_free(t);
 }
 
 /* The map kept from frame to frame (shadow_map_cached): made again when
- * the light's bits or the tree change, kept otherwise, and then the map a
- * build from scratch gives, bit for bit. */
-static void check_same_map(const shadow_map *m, const oct_tree *t, const double light[3])
+ * the light's bits or the tree change or finer cells are asked for, kept
+ * otherwise, and then the map a build from scratch gives, bit for bit. */
+static void check_same_map(const shadow_map *m, const oct_tree *t, const double light[3],
+                           unsigned up)
 {
     shadow_map fresh;
-    assert_int_equal(shadow_map_build(t, light, 1, &fresh), 0);
+    assert_int_equal(shadow_map_build(t, light, up, 1, &fresh), 0);
+    assert_int_equal(m->depth, fresh.depth);
     assert_memory_equal(m->light, light, sizeof m->light);
     assert_int_equal(m->nu, fresh.nu);
     assert_int_equal(m->nv, fresh.nv);
@@ -173,21 +183,28 @@ static void test_cache_follows_tree_and_light(void **state)
     shadow_map_cache c;
     memset(&c, 0, sizeof c);
     int built = -1;
-    const shadow_map *m = shadow_map_cached(&c, t[0], l1, 2, &built);
+    const unsigned C = SHADOW_MAP_COARSE, F = SHADOW_MAP_FINE;
+    const shadow_map *m = shadow_map_cached(&c, t[0], l1, C, 2, &built);
     assert_non_null(m);
     assert_int_equal(built, 1);
-    check_same_map(m, t[0], l1);
-    assert_ptr_equal(shadow_map_cached(&c, t[0], l1, 1, &built), m);
+    check_same_map(m, t[0], l1, C);
+    assert_ptr_equal(shadow_map_cached(&c, t[0], l1, C, 1, &built), m);
     assert_int_equal(built, 0); /* the same tree and light: kept */
-    m = shadow_map_cached(&c, t[0], l2, 2, &built);
+    m = shadow_map_cached(&c, t[0], l1, F, 2, &built);
+    assert_int_equal(built, 1); /* finer cells asked for: made again */
+    check_same_map(m, t[0], l1, F);
+    assert_ptr_equal(shadow_map_cached(&c, t[0], l1, C, 2, &built), m);
+    assert_int_equal(built, 0); /* coarser asked for: the finer one kept */
+    check_same_map(m, t[0], l1, F);
+    m = shadow_map_cached(&c, t[0], l2, C, 2, &built);
     assert_int_equal(built, 1);
-    check_same_map(m, t[0], l2);
-    m = shadow_map_cached(&c, t[0], l1z, 2, &built);
+    check_same_map(m, t[0], l2, C);
+    m = shadow_map_cached(&c, t[0], l1z, C, 2, &built);
     assert_int_equal(built, 1);
-    check_same_map(m, t[0], l1z);
-    m = shadow_map_cached(&c, t[1], l1z, 2, &built);
+    check_same_map(m, t[0], l1z, C);
+    m = shadow_map_cached(&c, t[1], l1z, C, 2, &built);
     assert_int_equal(built, 1); /* another tree */
-    check_same_map(m, t[1], l1z);
+    check_same_map(m, t[1], l1z, C);
     shadow_map_cache_free(&c);
     assert_null(c.tree);
     shadow_map_cache_free(&c); /* twice: nothing kept, nothing freed */
@@ -211,9 +228,12 @@ static void test_stopped_rays_same_answers(void **state)
     static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5},
                                        {0, 0, 1}};
     enum { NL = sizeof lights / sizeof lights[0] };
-    shadow_map maps[NL];
-    for (unsigned l = 0; l < NL; l++)
-        assert_int_equal(shadow_map_build(t, lights[l], 2, &maps[l]), 0);
+    shadow_map maps[2 * NL]; /* light l's with cells of voxels, then of 4 voxels */
+    for (unsigned l = 0; l < 2 * NL; l++)
+        assert_int_equal(shadow_map_build(t, lights[l % NL], l < NL ? SHADOW_MAP_FINE
+                                                                     : SHADOW_MAP_COARSE,
+                                          2, &maps[l]),
+                         0);
     unsigned long rays = 0, blocked = 0, fewer = 0;
     for (unsigned impl = 0; impl < trace_impl_count; impl++)
         for (int refine = 0; refine <= 1; refine++) {
@@ -229,11 +249,12 @@ static void test_stopped_rays_same_answers(void **state)
                         continue;
                     if (!shadow_start_hit(t, &h, n, &st))
                         continue;
-                    for (unsigned l = 0; l < NL; l++) {
+                    for (unsigned l = 0; l < 2 * NL; l++) {
                         uint64_t s0 = 0, s1 = 0;
-                        const int b0 = shadow_blocked_from(t, &o, fn, &st, NULL, lights[l],
+                        const double *light = lights[l % NL];
+                        const int b0 = shadow_blocked_from(t, &o, fn, &st, NULL, light,
                                                            INFINITY, &s0);
-                        const int b1 = shadow_blocked_from(t, &o, fn, &st, &maps[l], lights[l],
+                        const int b1 = shadow_blocked_from(t, &o, fn, &st, &maps[l], light,
                                                            INFINITY, &s1);
                         assert_int_equal(b0, b1);
                         assert_true(s1 <= s0);
@@ -243,11 +264,96 @@ static void test_stopped_rays_same_answers(void **state)
                     }
                 }
         }
-    for (unsigned l = 0; l < NL; l++)
+    for (unsigned l = 0; l < 2 * NL; l++)
         shadow_map_free(&maps[l]);
     print_message("stopped rays: %lu rays, %lu blocked, %lu in fewer steps\n", rays, blocked,
                   fewer);
     assert_true(rays > 4000 && blocked > 200 && fewer > rays / 4);
+    tree_util_free(t);
+}
+
+/* A shadow ray the map answers where it would start (shadow_lit_stored,
+ * shadow_lit_at: no start search, no set-up) has the answer of the start
+ * and the walk it skips: lit, from a start outside every occupied voxel;
+ * with a map of another light, or of cells above the voxels, it is never
+ * answered so. From voxel hits and from world points (the --exact path). */
+static void test_lit_at_start_same_answers(void **state)
+{
+    (void)state;
+    enum { LEVELS = 6 };
+    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
+                   shape_sphere(40, 40, 30, 8)};
+    sh[0].lo[0] = 20;
+    sh[1].lo[2] = 20;
+    oct_tree *t = shapes_build(LEVELS, 64.0, sh, 3, 1);
+    assert_non_null(t);
+    const double eye[3] = {150, 110, 120};
+    static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5}};
+    enum { NL = sizeof lights / sizeof lights[0] };
+    const trace_opts o = {.split = LEVELS};
+    const double vox = t->edge / (double)(1u << LEVELS);
+    unsigned long asked = 0, answered[2] = {0, 0};
+    for (unsigned up = SHADOW_MAP_FINE; up <= SHADOW_MAP_COARSE; up += 2)
+        for (unsigned l = 0; l < NL; l++) {
+            shadow_map m;
+            assert_int_equal(shadow_map_build(t, lights[l], up, 2, &m), 0);
+            shadow_start st;
+            st.near = 0;
+            for (int y = 0; y < GRID_HITS_SIDE; y++)
+                for (int x = 0; x < GRID_HITS_SIDE; x++) {
+                    trace_hit h;
+                    float n[3], ns[3];
+                    if (!grid_hit(t, &o, eye, x, y, &h, n))
+                        continue;
+                    oct_normal_decode(t->voxels[h.voxel] & OCT_VOXEL_NORMAL_MASK, ns);
+                    double p[3]; /* a world point of the hit voxel, for the exact path */
+                    for (int a = 0; a < 3; a++)
+                        p[a] = t->origin[a] + ((double)h.xyz[a] + 0.25 + 0.125 * a) * vox;
+                    for (int at = 0; at < 2; at++) {
+                        const int lit = at ? shadow_lit_at(t, p, n, &m, lights[l])
+                                           : shadow_lit_stored(t, &h, ns, n, &m, lights[l]);
+                        assert_int_equal(at ? shadow_lit_at(t, p, n, &m, lights[(l + 1) % NL])
+                                            : shadow_lit_stored(t, &h, ns, n, &m,
+                                                                lights[(l + 1) % NL]),
+                                         0);
+                        asked++;
+                        if (!lit)
+                            continue;
+                        answered[up == SHADOW_MAP_COARSE]++;
+                        assert_int_equal(at ? shadow_start_at(t, p, n, &st)
+                                            : shadow_start_stored(t, &h, ns, n, &st),
+                                         1);
+                        uint64_t s0 = 0, s1 = 0;
+                        assert_int_equal(shadow_blocked_from(t, &o, NULL, &st, &m, lights[l],
+                                                             INFINITY, &s0),
+                                         0);
+                        assert_int_equal(s0, 0); /* the map answers, no walk */
+                        assert_int_equal(shadow_blocked_from(t, &o, NULL, &st, NULL, lights[l],
+                                                             INFINITY, &s1),
+                                         0);
+                    }
+                }
+            shadow_map_free(&m);
+        }
+    print_message("lit where they start: %lu of %lu asked (voxel cells), %lu (4-voxel cells)\n",
+                  answered[0], asked / 2, answered[1]);
+    assert_true(answered[0] > asked / 8);
+    assert_int_equal(answered[1], 0); /* only a map of voxels is asked */
+    tree_util_free(t);
+}
+
+/* The map worth making: the fine one from two pixels a voxel on. */
+static void test_map_resolution_rule(void **state)
+{
+    (void)state;
+    uint32_t xyz[3][3] = {{1, 1, 1}, {5, 2, 7}, {3, 3, 3}};
+    oct_tree *t = tree_util_simple(4, (const uint32_t(*)[3])xyz, 3);
+    assert_non_null(t);
+    assert_int_equal(shadow_map_up_for(t, 5), SHADOW_MAP_COARSE);
+    assert_int_equal(shadow_map_up_for(t, 6), SHADOW_MAP_FINE);
+    assert_int_equal(shadow_map_depth(t, SHADOW_MAP_FINE), 4);
+    assert_int_equal(shadow_map_depth(t, SHADOW_MAP_COARSE), 2);
+    assert_int_equal(shadow_map_depth(t, 7), 1); /* at least the root's children */
     tree_util_free(t);
 }
 
@@ -287,6 +393,8 @@ int main(void)
         cmocka_unit_test(test_same_map_any_threads),
         cmocka_unit_test(test_cache_follows_tree_and_light),
         cmocka_unit_test(test_stopped_rays_same_answers),
+        cmocka_unit_test(test_lit_at_start_same_answers),
+        cmocka_unit_test(test_map_resolution_rule),
         cmocka_unit_test(test_grid_hit_faces_eye),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

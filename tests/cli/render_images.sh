@@ -67,4 +67,18 @@ expect_exit 0 "$R" "$T/t.oct" --views "$T/ok.views" --size 40x30 --aa 3
 grep -c "supersampled" "$ERR" | grep -qx 3 || fail "views: --aa not per view"
 expect_exit 0 "$R" "$T/t.oct" -o "$T/v2b.png" --size 40x30 --aa 3 --shadows --ao 2 -q
 cmp -s "$T/v2.png" "$T/v2b.png" || fail "views line differs from the same command line"
+
+# shadows under one light over many views (a shadow map of voxels, made once
+# and asked where the rays start) give the images of each view alone (a
+# map of coarser cells): four 96x96 views are over two pixels a voxel here
+printf '%s\n' "-o $T/s1.png" "-o $T/s2.png --eye 2,-1.5,1" "-o $T/s3.png --exact" \
+    "-o $T/s4.png --eye -1,2,1.5 --exact" >"$T/sh.views"
+expect_exit 0 "$R" "$T/t.oct" --views "$T/sh.views" --size 96x96 --shadows --light 0.3,0.4,0.85 -q
+for v in "1:" "2:--eye 2,-1.5,1" "3:--exact" "4:--eye -1,2,1.5 --exact"; do
+    k=${v%%:*}
+    # shellcheck disable=SC2086 # the view's options split into words
+    expect_exit 0 "$R" "$T/t.oct" -o "$T/s${k}b.png" ${v#*:} --size 96x96 --shadows \
+        --light 0.3,0.4,0.85 -q
+    cmp -s "$T/s$k.png" "$T/s${k}b.png" || fail "shadows: view $k of a run differs from it alone"
+done
 pass
