@@ -21,6 +21,7 @@
 #include "render/aa.h"
 #include "render/ao.h"
 #include "render/exact_load.h"
+#include "render/view_light.h"
 #include "render/frame.h"
 #include "render/framing.h"
 #include "render/map_guard.h"
@@ -398,38 +399,6 @@ static int prepare_views(const oct_tree *tree, const char *views_path, views_vie
     return EXIT_OK;
 }
 
-/* The unit light of a view: --light's, else over the camera's shoulder. */
-static void view_light(const render_args *o, const camera *cam, double light[3])
-{
-    if (o->has_light) {
-        shade_params sp;
-        shade_set_light(&sp, o->light); /* checked when parsed */
-        for (int a = 0; a < 3; a++)
-            light[a] = sp.light[a];
-    } else {
-        shade_default_light(cam, light);
-    }
-}
-
-/* The pixels of view k and of the later views of the run (every step-th)
- * that cast shadows under the same light: the frames a shadow map made for
- * view k will serve (shadow_map_up_for). 0 when view k casts none. */
-static uint64_t shadow_pixels_ahead(const render_args *o, const views_view *list, size_t nviews,
-                                    const camera *cams, size_t k, size_t step)
-{
-    if (!list[k].shadows)
-        return 0;
-    double lk[3], lj[3];
-    view_light(o, &cams[k], lk);
-    uint64_t px = 0;
-    for (size_t j = k; j < nviews; j += step) {
-        view_light(o, &cams[j], lj);
-        if (list[j].shadows && memcmp(lj, lk, sizeof lk) == 0)
-            px += (uint64_t)list[j].width * (uint64_t)list[j].height;
-    }
-    return px;
-}
-
 /* Renders one view and writes its images; adds its time and rays to the
  * totals. Returns EXIT_OK or EXIT_RUNTIME. */
 static int render_view(const oct_tree *tree, const render_args *o, const views_view *v,
@@ -447,7 +416,7 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     job.shade.ambient = 0.15f;
     for (int a = 0; a < 3; a++)
         job.shade.background[a] = (float)o->bg[a];
-    view_light(o, cam, job.shade.light);
+    view_light(o->has_light, o->light, cam, job.shade.light);
     job.shadow_pixels = shadow_pixels;
     job.rgb = buf->rgb;
     job.depth = v->depth ? buf->depth : NULL;
@@ -505,6 +474,9 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
     size_t first = o->part_count ? (size_t)o->part_index : 0, step = o->part_count ? (size_t)o->part_count : 1;
     size_t done = 0;
     frame_keep keep = {0}; /* the shadow map and the border probes, view to view */
+    uint64_t *ahead = calloc(nviews, sizeof *ahead); /* NULL: each frame's own pixels */
+    if (ahead)
+        view_shadow_pixels(o->has_light, o->light, list, cams, nviews, first, step, ahead);
     for (size_t k = first; k < nviews; k += step, done++) {
         test_hooks_view((unsigned)k + 1);
         int st = EXIT_RUNTIME;
@@ -512,14 +484,15 @@ static int render_views(const oct_tree *tree, const render_args *o, const views_
             diag_path_error(o->oct_path, "changed while being read");
         else
             st = render_view(tree, o, &list[k], &cams[k], buf, es, &keep,
-                             shadow_pixels_ahead(o, list, nviews, cams, k, step), &total_ms,
-                             &total_rays);
+                             ahead ? ahead[k] : 0, &total_ms, &total_rays);
         if (st != EXIT_OK) {
             frame_keep_free(&keep);
+            free(ahead);
             return st;
         }
     }
     frame_keep_free(&keep);
+    free(ahead);
     if (!o->quiet && o->part_count)
         fprintf(stderr, "render: part %ld/%ld: %zu of %zu views\n", o->part_index, o->part_count, done,
                 nviews);

@@ -49,10 +49,12 @@ typedef struct build_ctx {
 
 /* The cells of a parent of cells (corner projections p, its children
  * `ch`) into top: each raises the texels its box (c->box) meets to its
- * greatest height (rounded to nearest; finish adds the rest). A box lies
- * inside the cube's projection grown by the margin, which the map holds
- * with a grid unit (at least a texel) to spare on each side, and two
- * texels more after the last: its 3x3 texels need no clamp. */
+ * greatest height (rounded to nearest; finish adds the rest). A box is at
+ * most 2 x 0.87 texels wide (one to three texels each way) and lies inside
+ * the cube's projection grown by the margin; the map starts a grid unit
+ * before that projection (its indices are never negative) and ends two
+ * texels after it: the 3x3 block from the box's first texel needs no
+ * clamp. */
 static void put_cells_of(const build_ctx *c, float *top, const double p[3], oct_children ch)
 {
     const size_t nu = c->m->nu;
@@ -191,21 +193,6 @@ static int put_cells(build_ctx *c, unsigned threads)
     return 0;
 }
 
-/* The least float above f (finite), by its bits. */
-static float float_next_up(float f)
-{
-    uint32_t b;
-    memcpy(&b, &f, sizeof b);
-    if (f > 0.0f)
-        b++;
-    else if (f < 0.0f)
-        b--;
-    else
-        b = 1u; /* the least subnormal */
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-
 /* The texels' heights, rounded to nearest, one float step up: no lower
  * than the heights they were rounded from. */
 static void finish(shadow_map *m)
@@ -213,18 +200,21 @@ static void finish(shadow_map *m)
     float *t = m->top;
     for (size_t k = 0, n = (size_t)m->nu * m->nv; k < n; k++)
         if (t[k] != -INFINITY)
-            t[k] = float_next_up(t[k]);
+            t[k] = nextafterf(t[k], INFINITY);
 }
 
 unsigned shadow_map_depth(const oct_tree *tree, unsigned up)
 {
     const unsigned d = tree->levels > up ? tree->levels - up : 1u;
-    return d < SHADOW_MAP_MAX_DEPTH ? d : SHADOW_MAP_MAX_DEPTH;
+    const unsigned cap = up == SHADOW_MAP_FINE ? SHADOW_MAP_MAX_DEPTH : SHADOW_MAP_MAX_DEPTH - 1u;
+    return d < cap ? d : cap;
 }
 
 unsigned shadow_map_up_for(const oct_tree *tree, uint64_t pixels)
 {
-    return pixels >= 2u * tree->voxel_count ? SHADOW_MAP_FINE : SHADOW_MAP_COARSE;
+    return tree->levels <= SHADOW_MAP_MAX_DEPTH && pixels >= 2u * tree->voxel_count
+               ? SHADOW_MAP_FINE
+               : SHADOW_MAP_COARSE;
 }
 
 int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, unsigned threads,

@@ -3,8 +3,8 @@
  * to one point of the plane across it; the map holds, per square of that
  * plane (a texel, as wide as a cell), the greatest height along the light of
  * any occupied cell of its depth whose projection meets the texel (the box
- * of the cell's projected corners, and their top, grown by
- * SHADOW_MAP_MARGIN).
+ * of the projected corners of the cell, or above the voxels of its occupied
+ * children, and their top, grown by SHADOW_MAP_MARGIN).
  * A ray whose height has passed its texel's value meets no occupied voxel
  * after that: its shadow test can stop there with the same answer. */
 #ifndef SHADOW_MAP_H
@@ -14,7 +14,8 @@
 
 #include "format/oct.h"
 
-#define SHADOW_MAP_MAX_DEPTH 10  /* cells no deeper: under 1 800 texels a side */
+#define SHADOW_MAP_MAX_DEPTH 10  /* cells no deeper (a coarse map's: 9): under
+                                    1 800 texels a side */
 #define SHADOW_MAP_FINE 0        /* `up`: cells of depth levels - up, the voxels */
 #define SHADOW_MAP_COARSE 2      /* cells of 4 voxels a side */
 #define SHADOW_MAP_MARGIN 0x1p-6 /* grid units: far above the roundings of the
@@ -32,12 +33,13 @@ typedef struct shadow_map {
 } shadow_map;
 
 /* The depth of the cells of a map `up` levels above the voxels (at least 1,
- * at most SHADOW_MAP_MAX_DEPTH). */
+ * at most SHADOW_MAP_MAX_DEPTH, or one less for a coarse map). */
 unsigned shadow_map_depth(const oct_tree *tree, unsigned up);
 
 /* The map worth making for `pixels` pixels to come under one light (the
- * frames that will share it): SHADOW_MAP_FINE from two pixels a voxel on,
- * else SHADOW_MAP_COARSE. The fine map costs some 80 instructions a voxel
+ * frames that will share it): SHADOW_MAP_FINE from two pixels a voxel on
+ * when the map can hold the voxels (levels <= SHADOW_MAP_MAX_DEPTH), else
+ * SHADOW_MAP_COARSE. The fine map costs some 80 instructions a voxel
  * more to make and answers most lit shadow rays where they start, some 300
  * instructions fewer a ray (docs/perf-log.md). */
 unsigned shadow_map_up_for(const oct_tree *tree, uint64_t pixels);

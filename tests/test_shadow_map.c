@@ -47,9 +47,10 @@ static int box_span(const double g[3], const double D[3], const uint32_t v[3], d
 }
 
 /* Every voxel a ray meets, even at one point, is met before the map's
- * time: random trees of 5 and 6 levels (scattered and clustered voxels),
- * lights with and without zero components, starts inside and outside, maps
- * of voxels and of cells of 4 voxels. */
+ * time: random trees of 5, 6 and 20 levels (scattered and clustered
+ * voxels), lights with and without zero components, starts inside and
+ * outside, maps of voxels and of cells of 4 voxels (at 20 levels, of cells
+ * of depth 10 and 9 above the voxels). */
 static void test_clear_t_bounds_every_voxel(void **state)
 {
     (void)state;
@@ -57,12 +58,18 @@ static void test_clear_t_bounds_every_voxel(void **state)
                                        {1, -1, 0},        {-0.1, -0.7, -0.2}, {0, -1, 0}};
     uint64_t rng = 0x5eed5eedu;
     unsigned long met = 0, finite = 0, none = 0;
-    for (unsigned levels = 5; levels <= 6; levels++)
+    static const unsigned depths[] = {5, 6, 20};
+    for (unsigned li = 0; li < 3; li++)
         for (unsigned form = 0; form < 2; form++) {
+            const unsigned levels = depths[li];
             const uint32_t n = UINT32_C(1) << levels;
             static uint32_t xyz[600][3];
-            const size_t nv = form ? tree_util_distinct_voxels(600, n / 4, n / 3, &rng, xyz)
-                                   : tree_util_distinct_voxels(150, 0, n, &rng, xyz);
+            /* 20 levels: clustered at the far corner, where heights are
+               large (a float's step is 8 times the margin there) and the
+               map's last texels are reached */
+            const size_t nv = form   ? tree_util_distinct_voxels(600, n / 4, n / 3, &rng, xyz)
+                              : li == 2 ? tree_util_distinct_voxels(300, n - 40, 40, &rng, xyz)
+                                      : tree_util_distinct_voxels(150, 0, n, &rng, xyz);
             oct_tree *t = tree_util_simple(levels, (const uint32_t(*)[3])xyz, nv);
             assert_non_null(t);
             const double scale = (double)n / t->edge;
@@ -71,7 +78,7 @@ static void test_clear_t_bounds_every_voxel(void **state)
                 const size_t l = q / 2;
                 const unsigned up = q % 2 ? SHADOW_MAP_COARSE : SHADOW_MAP_FINE;
                 assert_int_equal(shadow_map_build(t, lights[l], up, 1, &m), 0);
-                assert_int_equal(m.depth, levels - up);
+                assert_int_equal(m.depth, li < 2 ? levels - up : up ? 9 : 10); /* capped */
                 const double D[3] = {scale * lights[l][0], scale * lights[l][1],
                                      scale * lights[l][2]};
                 for (int k = 0; k < 400; k++) {
@@ -112,6 +119,48 @@ static void test_clear_t_bounds_every_voxel(void **state)
     print_message("map: %lu rays meeting voxels, %lu with a finite end, %lu clear from the start\n",
                   met, finite, none);
     assert_true(met > 4000 && none > 2000);
+}
+
+/* Heights far from the origin: at 20 levels a float's step is 8 times the
+ * margin, so the map's heights must be rounded up. One voxel at the cube's
+ * far corner, lights nearly along z (its top face a hair below its top
+ * corner's height), rays along the light that enter it through the side
+ * y = N - 1 a thousandth below the top face and leave through that face:
+ * the map's time is after their entry (maps of cells of depth 10 and 9,
+ * whose tops are that corner too). */
+static void test_far_heights_rounded_up(void **state)
+{
+    (void)state;
+    enum { LEVELS = 20 };
+    const uint32_t n = UINT32_C(1) << LEVELS;
+    const uint32_t xyz[1][3] = {{n - 1, n - 1, n - 1}};
+    oct_tree *t = tree_util_simple(LEVELS, xyz, 1);
+    assert_non_null(t);
+    const double scale = (double)n / t->edge;
+    unsigned checked = 0;
+    for (unsigned q = 1; q <= 60; q++) {
+        const double light[3] = {0.0001 * (q % 7), 0.001 + 0.0001 * q, 1.0};
+        const double D[3] = {scale * light[0], scale * light[1], scale * light[2]};
+        for (unsigned up = SHADOW_MAP_FINE; up <= SHADOW_MAP_COARSE; up += 2) {
+            shadow_map m;
+            assert_int_equal(shadow_map_build(t, light, up, 1, &m), 0);
+            for (int b = 0; b < 4; b++) {
+                const double p[3] = {(double)n - 0.2 - 0.2 * b, (double)n - 1.0,
+                                     (double)n - 0.001};
+                double g[3];
+                for (int a = 0; a < 3; a++)
+                    g[a] = p[a] - 2.0 * D[a];
+                double t0, t1;
+                assert_true(box_span(g, D, xyz[0], &t0, &t1));
+                assert_true(t1 - t0 < 0.01); /* a short chord under the top */
+                assert_true(t0 < shadow_map_clear_t(&m, g, light, scale));
+                checked++;
+            }
+            shadow_map_free(&m);
+        }
+    }
+    assert_int_equal(checked, 60 * 2 * 4);
+    tree_util_free(t);
 }
 
 /* The map is the same whatever the number of threads that build it (each
@@ -390,6 +439,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_clear_t_bounds_every_voxel),
+        cmocka_unit_test(test_far_heights_rounded_up),
         cmocka_unit_test(test_same_map_any_threads),
         cmocka_unit_test(test_cache_follows_tree_and_light),
         cmocka_unit_test(test_stopped_rays_same_answers),

@@ -70,7 +70,12 @@ cmp -s "$T/v2.png" "$T/v2b.png" || fail "views line differs from the same comman
 
 # shadows under one light over many views (a shadow map of voxels, made once
 # and asked where the rays start) give the images of each view alone (a
-# map of coarser cells): four 96x96 views are over two pixels a voxel here
+# map of coarser cells): four 96x96 views are over two pixels a voxel here,
+# one is under (shadow_map_up_for)
+nvox=$("$BIN/rasterize" "$ROOT/scenes/torus.scene" -o "$T/t2.oct" --levels 6 2>&1 |
+    sed -n 's/.*), \([0-9]*\) voxels,.*/\1/p')
+[ -n "$nvox" ] && [ "$nvox" -gt 4608 ] && [ "$nvox" -le 18432 ] ||
+    fail "shadows: $nvox voxels: the views below do not choose both maps"
 printf '%s\n' "-o $T/s1.png" "-o $T/s2.png --eye 2,-1.5,1" "-o $T/s3.png --exact" \
     "-o $T/s4.png --eye -1,2,1.5 --exact" >"$T/sh.views"
 expect_exit 0 "$R" "$T/t.oct" --views "$T/sh.views" --size 96x96 --shadows --light 0.3,0.4,0.85 -q
