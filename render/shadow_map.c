@@ -217,6 +217,16 @@ unsigned shadow_map_up_for(const oct_tree *tree, uint64_t pixels)
                : SHADOW_MAP_COARSE;
 }
 
+/* The projection on axis ax of the offset (k_x + shift, k_y + shift,
+ * k_z + shift) * step, k's bits the child's place in its parent: a child's
+ * corner or centre from a corner or centre, by the shift. */
+static double corner_along(const double ax[3], unsigned k, double shift, double step)
+{
+    return ((double)(k & 1u) + shift) * step * ax[0] +
+           ((double)(k >> 1 & 1u) + shift) * step * ax[1] +
+           ((double)(k >> 2 & 1u) + shift) * step * ax[2];
+}
+
 int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, unsigned threads,
                      shadow_map *m)
 {
@@ -256,25 +266,17 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
     if (!m->top)
         return -1;
     const double *axes[3] = {m->u, m->v, m->w};
-    for (unsigned d = 0; d + 1u < c.depth; d++) {
-        const double half = (double)(UINT32_C(1) << (levels - d - 1u));
+    for (unsigned d = 0; d + 1u < c.depth; d++) /* child k's corner from its parent's */
         for (unsigned k = 0; k < 8; k++)
-            for (int p = 0; p < 3; p++) {
-                const double *ax = axes[p];
-                c.child[d][k][p] = (double)(k & 1u) * half * ax[0] +
-                                   (double)(k >> 1 & 1u) * half * ax[1] +
-                                   (double)(k >> 2 & 1u) * half * ax[2];
-            }
-    }
+            for (int p = 0; p < 3; p++)
+                c.child[d][k][p] =
+                    corner_along(axes[p], k, 0.0, (double)(UINT32_C(1) << (levels - d - 1u)));
     /* a cell's centre from its parent's corner; u and v from the plane's
        origin in texels (the texel side is a power of two: scaling by it is
        exact) */
     for (unsigned k = 0; k < 8; k++)
         for (int p = 0; p < 3; p++) {
-            const double *ax = axes[p];
-            const double x = ((double)(k & 1u) + 0.5) * side * ax[0] +
-                             ((double)(k >> 1 & 1u) + 0.5) * side * ax[1] +
-                             ((double)(k >> 2 & 1u) + 0.5) * side * ax[2];
+            const double x = corner_along(axes[p], k, 0.5, side);
             c.centre[k][p] = p == 2 ? x : (x - (p ? m->v0 : m->u0)) * m->inv_texel;
         }
     /* a child's corners from the cell's centre, at most, grown by the
@@ -293,11 +295,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (unsigned k = 0; k < 8; k++)
             for (int p = 0; mask >> k & 1u && p < 3; p++) {
-                /* child k's corner from the cell's centre, projected */
-                const double *ax = axes[p];
-                const double o = ((double)(k & 1u) - 1.0) * half * ax[0] +
-                                 ((double)(k >> 1 & 1u) - 1.0) * half * ax[1] +
-                                 ((double)(k >> 2 & 1u) - 1.0) * half * ax[2];
+                const double o = corner_along(axes[p], k, -1.0, half); /* from the centre */
                 lo[p] = fmin(lo[p], o + clo[p]);
                 hi[p] = fmax(hi[p], o + chi[p]);
             }
