@@ -261,18 +261,27 @@ static void test_cache_follows_tree_and_light(void **state)
         tree_util_free(t[k]);
 }
 
+/* The scene of the shadow tests: a floor and a wall meeting at a corner,
+ * a ball above the floor, SCENE_LEVELS levels over a cube of 64. */
+enum { SCENE_LEVELS = 6 };
+static oct_tree *floor_wall_ball(void)
+{
+    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
+                   shape_sphere(40, 40, 30, 8)};
+    sh[0].lo[0] = 20;
+    sh[1].lo[2] = 20;
+    oct_tree *t = shapes_build(SCENE_LEVELS, 64.0, sh, 3, 1);
+    assert_non_null(t);
+    return t;
+}
+
 /* Shadow rays from the hits of a view, stopped where the map says: the
  * answers of the rays traced whole, never more steps. */
 static void test_stopped_rays_same_answers(void **state)
 {
     (void)state;
-    enum { LEVELS = 6 };
-    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
-                   shape_sphere(40, 40, 30, 8)};
-    sh[0].lo[0] = 20;
-    sh[1].lo[2] = 20;
-    oct_tree *t = shapes_build(LEVELS, 64.0, sh, 3, 1);
-    assert_non_null(t);
+    enum { LEVELS = SCENE_LEVELS };
+    oct_tree *t = floor_wall_ball();
     const double eye[3] = {150, 110, 120};
     static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5},
                                        {0, 0, 1}};
@@ -329,13 +338,8 @@ static void test_stopped_rays_same_answers(void **state)
 static void test_lit_at_start_same_answers(void **state)
 {
     (void)state;
-    enum { LEVELS = 6 };
-    shape sh[3] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5),
-                   shape_sphere(40, 40, 30, 8)};
-    sh[0].lo[0] = 20;
-    sh[1].lo[2] = 20;
-    oct_tree *t = shapes_build(LEVELS, 64.0, sh, 3, 1);
-    assert_non_null(t);
+    enum { LEVELS = SCENE_LEVELS };
+    oct_tree *t = floor_wall_ball();
     const double eye[3] = {150, 110, 120};
     static const double lights[][3] = {{0.3, 0.2, 0.93}, {-0.8, 0.1, 0.59}, {0.5, 0.7, 0.5}};
     enum { NL = sizeof lights / sizeof lights[0] };
