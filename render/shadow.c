@@ -30,6 +30,20 @@ static int voxel_occupied(const oct_tree *tree, const double g[3], shadow_start 
     return (int)(an->node[an->depth].mask >> c & 1u);
 }
 
+/* A voxel's edge in world units. */
+static double voxel_edge(const oct_tree *tree)
+{
+    return tree->edge / (double)(UINT64_C(1) << tree->levels);
+}
+
+/* The world point of grid point g, as the start keeps it (s->o). */
+static void world_of(const oct_tree *tree, const double g[3], double o[3])
+{
+    const double vox = voxel_edge(tree);
+    for (int a = 0; a < 3; a++)
+        o[a] = tree->origin[a] + g[a] * vox;
+}
+
 /* Try k of the start point from base (grid units, on the surface) along n. */
 static void start_grid(const double base[3], const float n[3], unsigned k, double g[3])
 {
@@ -46,13 +60,11 @@ static int start_from(const oct_tree *tree, const double base[3], const float n[
 {
     if (!s->near)
         s->dir_ok = 0; /* a new tree, or a new shadow_start: no direction kept */
-    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
     double g[3];
     for (unsigned k = 0; k < SHADOW_TRIES; k++) {
         start_grid(base, n, k, g);
         if (!voxel_occupied(tree, g, s)) {
-            for (int a = 0; a < 3; a++)
-                s->o[a] = tree->origin[a] + g[a] * vox;
+            world_of(tree, g, s->o);
             trace_eye_init(tree, s->o, &s->eye);
             return 1;
         }
@@ -73,7 +85,7 @@ static void stored_base(const oct_tree *tree, const trace_hit *hit, const float 
 /* A world point p in grid units. */
 static void grid_of(const oct_tree *tree, const double p[3], double base[3])
 {
-    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
+    const double vox = voxel_edge(tree);
     for (int a = 0; a < 3; a++)
         base[a] = (p[a] - tree->origin[a]) / vox;
 }
@@ -102,20 +114,20 @@ int shadow_start_at(const oct_tree *tree, const double p[3], const float n[3], s
 
 /* shadow_lit_stored and shadow_lit_at from base. The first start point,
  * taken to the world and back as start_from and trace_eye_init do (the
- * same bits as the eye's grid position there), asked of the map: past
+ * same bits as the eye's grid position there: trace_eye_init's scale and
+ * (o - origin) * scale), asked of the map: past
  * every occupied cell there, it is in no occupied voxel either (the map
  * raises its texel above every point of one), so start_from would take it
  * and shadow_blocked_from would answer lit from the same query. */
 static int lit_from(const oct_tree *tree, const double base[3], const float n[3],
                     const shadow_map *map, const double light[3])
 {
-    const double nvox = (double)(UINT32_C(1) << tree->levels);
-    const double vox = tree->edge / (double)(UINT64_C(1) << tree->levels);
-    const double scale = nvox / tree->edge;
-    double g[3];
+    const double scale = (double)(UINT32_C(1) << tree->levels) / tree->edge;
+    double g[3], o[3];
     start_grid(base, n, 0, g);
+    world_of(tree, g, o);
     for (int a = 0; a < 3; a++)
-        g[a] = (tree->origin[a] + g[a] * vox - tree->origin[a]) * scale;
+        g[a] = (o[a] - tree->origin[a]) * scale;
     return shadow_map_clear_t(map, g, light, scale) <= 0.0;
 }
 

@@ -14,34 +14,30 @@
 
 enum { N = 7 };
 
-static void set_views(views_view *v, const int *shadows)
+/* A run of N views, view k with shadows[k] and the camera whose default
+ * light is one of two (which[k]: 0 or 1). */
+static void set_run(views_view *v, camera *cams, const int *shadows, const int *which)
 {
     memset(v, 0, N * sizeof *v);
+    memset(cams, 0, N * sizeof *cams);
     for (int k = 0; k < N; k++) {
         v[k].width = 10 + k;
         v[k].height = 2;
         v[k].shadows = shadows[k];
+        cams[k].forward[0] = which[k] ? 1.0 : -1.0;
+        cams[k].up[2] = 1.0;
+        cams[k].right[1] = 1.0;
     }
-}
-
-/* A camera whose default light is one of two (which: 0 or 1). */
-static void set_camera(camera *c, int which)
-{
-    memset(c, 0, sizeof *c);
-    c->forward[0] = which ? 1.0 : -1.0;
-    c->up[2] = 1.0;
-    c->right[1] = 1.0;
 }
 
 static void test_one_light(void **state)
 {
     (void)state;
     static const int shadows[N] = {1, 0, 1, 1, 0, 0, 1};
+    static const int which[N] = {0, 1, 0, 1, 0, 1, 0}; /* ignored: --light given */
     views_view v[N];
     camera cams[N];
-    set_views(v, shadows);
-    for (int k = 0; k < N; k++)
-        set_camera(&cams[k], k % 2); /* ignored: --light given */
+    set_run(v, cams, shadows, which);
     const double light[3] = {0.0, 0.0, 3.0};
     uint64_t ahead[N];
     memset(ahead, 0xff, sizeof ahead);
@@ -61,9 +57,7 @@ static void test_lights_of_cameras(void **state)
     static const int which[N] = {0, 0, 0, 1, 0, 0, 1};
     views_view v[N];
     camera cams[N];
-    set_views(v, shadows);
-    for (int k = 0; k < N; k++)
-        set_camera(&cams[k], which[k]);
+    set_run(v, cams, shadows, which);
     uint64_t ahead[N];
     view_shadow_pixels(0, NULL, v, cams, N, 0, 1, ahead);
     /* view 3's other light makes the map again: views 0-1 do not count 4-5,
@@ -80,12 +74,10 @@ static void test_lights_of_cameras(void **state)
 static void test_part_of_run(void **state)
 {
     (void)state;
-    static const int shadows[N] = {1, 1, 1, 1, 1, 1, 1};
+    static const int shadows[N] = {1, 1, 1, 1, 1, 1, 1}, which[N] = {0};
     views_view v[N];
     camera cams[N];
-    set_views(v, shadows);
-    for (int k = 0; k < N; k++)
-        set_camera(&cams[k], 0);
+    set_run(v, cams, shadows, which);
     uint64_t ahead[N];
     memset(ahead, 0, sizeof ahead);
     view_shadow_pixels(0, NULL, v, cams, N, 1, 3, ahead); /* views 1, 4 */
