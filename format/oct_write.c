@@ -8,19 +8,37 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/mman.h>
 #include <zlib.h>
 
 /* Bytes kept in chunks of STORE_CHUNK bytes: appending never moves what is
  * stored. (A doubling realloc of hundreds of megabytes copies them on some
  * systems and on others moves their pages, which a virtual machine may then
  * fault in again one by one when they are next read: docs/perf-log.md.) */
-#define STORE_BITS 22
+#define STORE_BITS 21
 #define STORE_CHUNK ((size_t)1 << STORE_BITS)
 typedef struct chunked {
     unsigned char **c;
     size_t nchunks, cap; /* chunks allocated, slots in c */
     size_t n;            /* bytes stored */
 } chunked;
+
+/* Chunk k of a store. From the second on, one huge page: aligned to its
+ * size with a huge-page hint, so filling it takes one page fault, not 512
+ * (each some 15 us of CPU on a virtual machine). The first keeps small
+ * pages, so a small store (the upper depths' masks) costs no more memory
+ * than it fills. */
+static void *chunk_alloc(size_t k)
+{
+    if (k == 0)
+        return oct__realloc(NULL, STORE_CHUNK);
+    void *p = oct__aligned_alloc(STORE_CHUNK, STORE_CHUNK);
+#ifdef MADV_HUGEPAGE
+    if (p)
+        (void)madvise(p, STORE_CHUNK, MADV_HUGEPAGE); /* a hint: small pages are fine */
+#endif
+    return p;
+}
 
 /* Appends n bytes; -1 (nothing appended) when memory runs out. */
 static int chunked_append(chunked *a, const void *data, size_t n)
@@ -39,7 +57,7 @@ static int chunked_append(chunked *a, const void *data, size_t n)
         a->cap = cap;
     }
     for (; a->nchunks < need; a->nchunks++) /* kept on failure: capacity */
-        if (!(a->c[a->nchunks] = oct__realloc(NULL, STORE_CHUNK)))
+        if (!(a->c[a->nchunks] = chunk_alloc(a->nchunks)))
             return -1;
     const unsigned char *p = data;
     while (n) {
