@@ -165,7 +165,7 @@ if has rasterize; then
 fi
 if has rastspeed; then
     echo
-    echo "Rasterize speed (issue 17), one run each: M voxels kept a second (wall time with start-up) with"
+    echo "Rasterize speed (issue 17), the run of median wall time of SPEED_REPS (full: 3): M voxels kept a second (wall time with start-up) with"
     echo "the records (normals and planes) and with \`--shell-only\`, and the CPU use (user + system over"
     echo "wall: 200 % keeps both cores busy). Targets: ≥ 10 M voxels/s, ≥ 25 with \`--shell-only\`"
     echo "(✓ met, ✗ not met)."

@@ -17,7 +17,7 @@ quick) # manyblobs' reference alone would take a minute
     LEVELS=${LEVELS:-"6 8"}; LEVELS_BLOBS=${LEVELS_BLOBS:-"6 7 8"}
     SIZE=${SIZE:-512}; NVIEWS=${NVIEWS:-1}; REPS=${REPS:-3}; RAST_REPS=${RAST_REPS:-1}
     FIG_LEVELS=${FIG_LEVELS:-8}; FIG_SIZES=${FIG_SIZES:-"256 512"}; POV_SIZE=${POV_SIZE:-256}
-    SPEED_SCENES=${SPEED_SCENES:-"blobs_a csg"}; SPEED_LEVELS=${SPEED_LEVELS:-8}
+    SPEED_SCENES=${SPEED_SCENES:-"blobs_a csg"}; SPEED_LEVELS=${SPEED_LEVELS:-8}; SPEED_REPS=${SPEED_REPS:-1}
     SHELL_LEVELS=${SHELL_LEVELS:-7}
     ACC_SCENES=${ACC_SCENES:-"sphere torus crease csg cube heart plate thin gyroid_ball"}
     ACC_LEVELS=${ACC_LEVELS:-9}; ACC_SIZE=${ACC_SIZE:-128}
@@ -30,7 +30,7 @@ full)
     FIG_LEVELS=${FIG_LEVELS:-10}; FIG_SIZES=${FIG_SIZES:-"256 512 1024"}
     POV_SIZE=${POV_SIZE:-1024}
     SPEED_SCENES=${SPEED_SCENES:-"blobs_a blobs_b csg gyroid manyblobs"}
-    SPEED_LEVELS=${SPEED_LEVELS:-"10 12"}; SHELL_LEVELS=${SHELL_LEVELS:-9}
+    SPEED_LEVELS=${SPEED_LEVELS:-"10 12"}; SPEED_REPS=${SPEED_REPS:-3}; SHELL_LEVELS=${SHELL_LEVELS:-9}
     ACC_SCENES=${ACC_SCENES:-$(for f in scenes/*.scene; do basename "$f" .scene; done)}
     ACC_LEVELS=${ACC_LEVELS:-"9 10"}; ACC_SIZE=${ACC_SIZE:-256}
     SWEEP_SCENES=${SWEEP_SCENES:-"blobs_a blobs_b thin csg gyroid manyblobs"}
@@ -152,15 +152,22 @@ if want main; then
 fi
 
 # ---- rasterize speed: M voxels kept a second and CPU use (user + system over
-# wall, 200 % = both cores busy to the end), one run each, full records and
+# wall, 200 % = both cores busy to the end), the median of SPEED_REPS runs, full records and
 # --shell-only; the shell: voxels kept over the voxels the surface really
 # passes through (bench/shellratio), and the records' errors (bench/normalerr) ----
 speed_run() { # SCENE LEVELS OUT [FLAGS]: prints "seconds voxels mvox_s cpu_pct"
     s=$1 L=$2 o=$3; shift 3
     if [ -x /usr/bin/time ]; then
-        /usr/bin/time -f "time %e %U %S" "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" \
-            >"$WORK/rlog" 2>&1
-        set -- $(sed -n 's/^time \([0-9.]*\) \([0-9.]*\) \([0-9.]*\)$/\1 \2 \3/p' "$WORK/rlog")
+        # the run of median wall time among SPEED_REPS (a shared machine's load comes and goes)
+        : >"$WORK/st"
+        r=0
+        while [ $r -lt "$SPEED_REPS" ]; do
+            /usr/bin/time -f "time %e %U %S" "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" \
+                >"$WORK/rlog" 2>&1
+            sed -n 's/^time \([0-9.]*\) \([0-9.]*\) \([0-9.]*\)$/\1 \2 \3/p' "$WORK/rlog" >>"$WORK/st"
+            r=$((r + 1))
+        done
+        set -- $(sort -g "$WORK/st" | sed -n "$(((SPEED_REPS + 1) / 2))p")
         sec=$1 cpu=$(awk -v w="$1" -v u="$2" -v k="$3" 'BEGIN { printf "%.0f", (w > 0 ? 100 * (u + k) / w : 0) }')
     else
         "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" >"$WORK/rlog" 2>&1
