@@ -10,6 +10,10 @@
 #include "common/big_alloc.h"
 #include "render/basis.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 /* The depth of the subtrees the threads take one at a time (at most 512). */
 #define SPLIT_DEPTH 3
 
@@ -33,8 +37,9 @@ typedef struct build_ctx {
                                                  projected: the corner's, summed on the way
                                                  down (one rounding a level, far under
                                                  the margin) */
-    double centre[8][3];      /* a cell's centre from its parent's corner, projected,
-                                 u and v in texels from the plane's origin */
+    double centre[3][8];      /* a cell's centre from its parent's corner, projected
+                                 (by axis, then child), u and v in texels from the
+                                 plane's origin */
     struct {
         double lo[2], hi[2];  /* a cell's box across the light from its centre, in
                                  texels (within 0.87 of it) */
@@ -64,12 +69,12 @@ static void put_cells_of(const build_ctx *c, float *top, const double p[3], oct_
     for (unsigned mask = ch.mask; mask; mask &= mask - 1u, index++) {
         const unsigned k = (unsigned)__builtin_ctz(mask);
         const unsigned cm = voxels ? 255u : oct_node_children(c->tree->groups[c->depth], index).mask;
-        const double cu = su + c->centre[k][0], cv = sv + c->centre[k][1];
+        const double cu = su + c->centre[0][k], cv = sv + c->centre[1][k];
         const size_t i0 = (size_t)(int64_t)(cu + c->box[cm].lo[0]);
         const size_t i1 = (size_t)(int64_t)(cu + c->box[cm].hi[0]);
         const size_t j0 = (size_t)(int64_t)(cv + c->box[cm].lo[1]);
         const size_t j1 = (size_t)(int64_t)(cv + c->box[cm].hi[1]);
-        const float f = (float)(p[2] + c->centre[k][2] + c->box[cm].top);
+        const float f = (float)(p[2] + c->centre[2][k] + c->box[cm].top);
         /* one to three texels each way: a 3x3 block raised without a branch,
            by -inf where the box ends short */
         const float col[3] = {f, i1 > i0 ? f : -INFINITY, i1 > i0 + 1u ? f : -INFINITY};
@@ -84,6 +89,56 @@ static void put_cells_of(const build_ctx *c, float *top, const double p[3], oct_
             }
     }
 }
+
+#if defined(__SSE2__)
+#define SHADOW_MAP_SSE2 1
+/* put_cells_of for a map of voxels (every cell's box is box[255]), in SSE2
+ * lanes: the eight children's texels and heights two at a time (the same
+ * sums in the same order as put_cells_of, so the same map), then each
+ * occupied voxel's 3x3 block as three rows of four texels (the fourth
+ * raised by -inf, unchanged: the map has a spare texel after its last). */
+static void put_voxels_of(const build_ctx *c, float *top, const double p[3], unsigned mask)
+{
+    const size_t nu = c->m->nu;
+    const __m128d SU = _mm_set1_pd(p[0] * c->m->inv_texel), SV = _mm_set1_pd(p[1] * c->m->inv_texel);
+    const __m128d W = _mm_set1_pd(p[2]), TOP = _mm_set1_pd(c->box[255].top);
+    const __m128d LU = _mm_set1_pd(c->box[255].lo[0]), HU = _mm_set1_pd(c->box[255].hi[0]);
+    const __m128d LV = _mm_set1_pd(c->box[255].lo[1]), HV = _mm_set1_pd(c->box[255].hi[1]);
+    int32_t i0[8], di[8], j0[8], dj[8];
+    float f[8];
+    for (int k = 0; k < 8; k += 2) {
+        const __m128d cu = _mm_add_pd(SU, _mm_loadu_pd(&c->centre[0][k]));
+        const __m128d cv = _mm_add_pd(SV, _mm_loadu_pd(&c->centre[1][k]));
+        const __m128i a = _mm_cvttpd_epi32(_mm_add_pd(cu, LU)); /* (int32_t), as put_cells_of */
+        const __m128i b = _mm_cvttpd_epi32(_mm_add_pd(cv, LV));
+        _mm_storel_epi64((__m128i *)&i0[k], a);
+        _mm_storel_epi64((__m128i *)&di[k], _mm_sub_epi32(_mm_cvttpd_epi32(_mm_add_pd(cu, HU)), a));
+        _mm_storel_epi64((__m128i *)&j0[k], b);
+        _mm_storel_epi64((__m128i *)&dj[k], _mm_sub_epi32(_mm_cvttpd_epi32(_mm_add_pd(cv, HV)), b));
+        const __m128d h = _mm_add_pd(_mm_add_pd(W, _mm_loadu_pd(&c->centre[2][k])), TOP);
+        _mm_storel_pi((__m64 *)&f[k], _mm_cvtpd_ps(h));
+    }
+    /* the texels of a row the box reaches, by how many follow its first (0..2) */
+    static const union {
+        uint32_t u[4];
+        float x[4];
+    } reach[3] = {{{~0u, 0, 0, 0}}, {{~0u, ~0u, 0, 0}}, {{~0u, ~0u, ~0u, 0}}};
+    const __m128 NONE = _mm_set1_ps(-INFINITY);
+    for (; mask; mask &= mask - 1u) {
+        const unsigned k = (unsigned)__builtin_ctz(mask);
+        const __m128 H = _mm_set1_ps(f[k]);
+        const __m128 R = _mm_loadu_ps(reach[di[k]].x);
+        const __m128 row = _mm_or_ps(_mm_and_ps(R, H), _mm_andnot_ps(R, NONE));
+        const __m128 row2 = dj[k] > 0 ? row : NONE, row3 = dj[k] > 1 ? row : NONE;
+        float *t = &top[(size_t)j0[k] * nu + (size_t)i0[k]];
+        _mm_storeu_ps(t, _mm_max_ps(row, _mm_loadu_ps(t)));
+        _mm_storeu_ps(t + nu, _mm_max_ps(row2, _mm_loadu_ps(t + nu)));
+        _mm_storeu_ps(t + 2 * nu, _mm_max_ps(row3, _mm_loadu_ps(t + 2 * nu)));
+    }
+}
+#else
+#define SHADOW_MAP_SSE2 0
+#endif
 
 /* Where a walk puts what it reaches at its stop depth: the nodes into list
  * (the threads' subtrees), or, list NULL, their cells into top. */
@@ -103,6 +158,12 @@ static void walk(const build_ctx *c, walk_out *out, unsigned d, unsigned stop,
     }
     const oct_children ch = oct_node_children(c->tree->groups[d], n->index);
     if (d == stop) {
+#if SHADOW_MAP_SSE2
+        if (c->depth == c->tree->levels) {
+            put_voxels_of(c, out->top, n->p, ch.mask);
+            return;
+        }
+#endif
         put_cells_of(c, out->top, n->p, ch);
         return;
     }
@@ -141,11 +202,18 @@ static void *build_run(void *arg)
     }
 }
 
-/* A map's texels, all -inf (a megabyte or more: big_alloc's). */
+/* A map's texels and the spare one after them (put_voxels_of's fourth
+ * column may reach it), all -inf (a megabyte or more: big_alloc's). */
+static size_t map_bytes(size_t texels)
+{
+    return texels < SIZE_MAX / sizeof(float) ? (texels + 1u) * sizeof(float) : 0;
+}
+
 static float *empty_map(size_t texels)
 {
-    float *t = texels <= SIZE_MAX / sizeof *t ? big_alloc(texels * sizeof *t) : NULL;
-    for (size_t k = 0; t && k < texels; k++)
+    const size_t bytes = map_bytes(texels);
+    float *t = bytes ? big_alloc(bytes) : NULL;
+    for (size_t k = 0; t && k <= texels; k++)
         t[k] = -INFINITY;
     return t;
 }
@@ -177,7 +245,7 @@ static int put_cells(build_ctx *c, unsigned threads)
         if (!w[started].top)
             break;
         if (pthread_create(&tid[started], NULL, build_run, &w[started]) != 0) {
-            big_free(w[started].top, texels * sizeof *w[started].top);
+            big_free(w[started].top, map_bytes(texels));
             break; /* the started threads and this one do the rest */
         }
     }
@@ -187,7 +255,7 @@ static int put_cells(build_ctx *c, unsigned threads)
         const float *src = w[t].top;
         for (size_t k = 0; k < texels; k++)
             m->top[k] = src[k] > m->top[k] ? src[k] : m->top[k];
-        big_free(w[t].top, texels * sizeof *src);
+        big_free(w[t].top, map_bytes(texels));
     }
     free(c->split);
     return 0;
@@ -277,7 +345,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
     for (unsigned k = 0; k < 8; k++)
         for (int p = 0; p < 3; p++) {
             const double x = corner_along(axes[p], k, 0.5, side);
-            c.centre[k][p] = p == 2 ? x : (x - (p ? m->v0 : m->u0)) * m->inv_texel;
+            c.centre[p][k] = p == 2 ? x : (x - (p ? m->v0 : m->u0)) * m->inv_texel;
         }
     /* a child's corners from the cell's centre, at most, grown by the
        margin; a cell's box, those of its occupied children */
@@ -315,7 +383,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
 
 void shadow_map_free(shadow_map *m)
 {
-    big_free(m->top, (size_t)m->nu * m->nv * sizeof *m->top);
+    big_free(m->top, map_bytes((size_t)m->nu * m->nv));
     m->top = NULL;
 }
 

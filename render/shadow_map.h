@@ -39,8 +39,8 @@ unsigned shadow_map_depth(const oct_tree *tree, unsigned up);
 /* The map worth making for `pixels` pixels to come under one light (the
  * frames that will share it): SHADOW_MAP_FINE from two pixels a voxel on
  * when the map can hold the voxels (levels <= SHADOW_MAP_MAX_DEPTH), else
- * SHADOW_MAP_COARSE. The fine map costs some 80 instructions a voxel
- * more to make and answers most lit shadow rays where they start, some 300
+ * SHADOW_MAP_COARSE. The fine map costs some 10 ns a voxel more to make
+ * (one core) and answers most lit shadow rays where they start, some 300
  * instructions fewer a ray (docs/perf-log.md). */
 unsigned shadow_map_up_for(const oct_tree *tree, uint64_t pixels);
 
