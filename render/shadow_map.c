@@ -54,7 +54,7 @@ typedef struct build_ctx {
 
 /* The cells of a parent of cells (corner projections p, its children
  * `ch`) into top: each raises the texels its box (c->box) meets to its
- * greatest height (rounded to nearest; finish adds the rest). A box is at
+ * greatest height (rounded to nearest; merge_run adds the rest). A box is at
  * most 2 x 0.87 texels wide (one to three texels each way) and lies inside
  * the cube's projection grown by the margin; the map starts a grid unit
  * before that projection (its indices are never negative) and ends two
@@ -179,27 +179,19 @@ static void walk(const build_ctx *c, walk_out *out, unsigned d, unsigned stop,
     }
 }
 
+/* A thread of the build: first its share of the subtrees into a map of its
+ * own, then its range of texels of the merge. */
 typedef struct build_worker {
     build_ctx *c;
-    float *top;
+    float *top;      /* its map: made by the thread itself, NULL when it could not be */
+    size_t lo, hi;   /* the merge: texels [lo, hi) */
+    float *const *maps;
+    unsigned nmaps;
 } build_worker;
 
 static unsigned split_depth(const build_ctx *c)
 {
     return c->depth - 1u < SPLIT_DEPTH ? c->depth - 1u : SPLIT_DEPTH;
-}
-
-static void *build_run(void *arg)
-{
-    const build_worker *w = arg;
-    build_ctx *c = w->c;
-    for (;;) {
-        const size_t k = atomic_fetch_add(&c->next, 1);
-        if (k >= c->nsplit)
-            return NULL;
-        walk_out out = {w->top, NULL, 0};
-        walk(c, &out, split_depth(c), c->depth - 1u, &c->split[k]);
-    }
 }
 
 /* A map's texels and the spare one after them (put_voxels_of's fourth
@@ -218,11 +210,65 @@ static float *empty_map(size_t texels)
     return t;
 }
 
-/* The cells put into m->top by up to `threads` threads. */
-static int put_cells(build_ctx *c, unsigned threads)
+static size_t map_texels(const shadow_map *m) { return (size_t)m->nu * m->nv; }
+
+/* Makes the thread's map (so that the threads clear theirs together), then
+ * takes subtrees until none is left; without a map it takes none. */
+static void *walk_run(void *arg)
 {
-    const shadow_map *m = c->m;
-    const size_t texels = (size_t)m->nu * m->nv;
+    build_worker *w = arg;
+    build_ctx *c = w->c;
+    if (!w->top)
+        w->top = empty_map(map_texels(c->m));
+    while (w->top) {
+        const size_t k = atomic_fetch_add(&c->next, 1);
+        if (k >= c->nsplit)
+            break;
+        walk_out out = {w->top, NULL, 0};
+        walk(c, &out, split_depth(c), c->depth - 1u, &c->split[k]);
+    }
+    return NULL;
+}
+
+/* Texels [lo, hi) of the threads' maps merged by their maximum into the
+ * first, each height then one float step up (rounded to nearest, it is no
+ * lower than the height it was rounded from). */
+static void *merge_run(void *arg)
+{
+    const build_worker *w = arg;
+    float *out = w->maps[0];
+    for (size_t k = w->lo; k < w->hi; k++) {
+        float v = out[k];
+        for (unsigned t = 1; t < w->nmaps; t++)
+            v = w->maps[t][k] > v ? w->maps[t][k] : v;
+        out[k] = v == -INFINITY ? v : nextafterf(v, INFINITY);
+    }
+    return NULL;
+}
+
+/* Runs fn on w[0 .. n - 1]: w[0] on this thread, the others on threads of
+ * their own where they can be started, else here after w[0]. */
+static void run_all(void *(*fn)(void *), build_worker *w, unsigned n)
+{
+    pthread_t tid[8];
+    int started[8] = {0};
+    for (unsigned t = 1; t < n; t++)
+        started[t] = pthread_create(&tid[t], NULL, fn, &w[t]) == 0;
+    fn(&w[0]);
+    for (unsigned t = 1; t < n; t++) {
+        if (started[t])
+            pthread_join(tid[t], NULL);
+        else
+            fn(&w[t]);
+    }
+}
+
+/* m->top made, the cells put into it and the heights stepped up, on up to
+ * `threads` threads: each puts whole subtrees into a map of its own, then
+ * each merges a range of texels. */
+static int put_cells(build_ctx *c, shadow_map *m, unsigned threads)
+{
+    const size_t texels = map_texels(m);
     const unsigned d = split_depth(c);
     c->split = malloc(((size_t)1 << (3 * d)) * sizeof *c->split);
     if (!c->split)
@@ -237,38 +283,33 @@ static int put_cells(build_ctx *c, unsigned threads)
     if ((size_t)threads > c->nsplit)
         threads = c->nsplit ? (unsigned)c->nsplit : 1u;
     build_worker w[8];
-    pthread_t tid[8];
-    unsigned started = 1;
-    w[0] = (build_worker){c, m->top};
-    for (; started < threads; started++) {
-        w[started] = (build_worker){c, empty_map(texels)};
-        if (!w[started].top)
-            break;
-        if (pthread_create(&tid[started], NULL, build_run, &w[started]) != 0) {
-            big_free(w[started].top, map_bytes(texels));
-            break; /* the started threads and this one do the rest */
-        }
-    }
-    build_run(&w[0]);
-    for (unsigned t = 1; t < started; t++) {
-        pthread_join(tid[t], NULL);
-        const float *src = w[t].top;
-        for (size_t k = 0; k < texels; k++)
-            m->top[k] = src[k] > m->top[k] ? src[k] : m->top[k];
-        big_free(w[t].top, map_bytes(texels));
-    }
+    for (unsigned t = 0; t < threads; t++)
+        w[t] = (build_worker){.c = c};
+    run_all(walk_run, w, threads);
     free(c->split);
-    return 0;
-}
-
-/* The texels' heights, rounded to nearest, one float step up: no lower
- * than the heights they were rounded from. */
-static void finish(shadow_map *m)
-{
-    float *t = m->top;
-    for (size_t k = 0, n = (size_t)m->nu * m->nv; k < n; k++)
-        if (t[k] != -INFINITY)
-            t[k] = nextafterf(t[k], INFINITY);
+    /* the maps that were made, this thread's first (a thread that could not
+       make one took no subtree) */
+    float *maps[8];
+    unsigned n = 0;
+    for (unsigned t = 0; t < threads; t++)
+        if (w[t].top)
+            maps[n++] = w[t].top;
+    int rc = 0;
+    if (!w[0].top || n == 0) {
+        rc = -1;
+    } else {
+        for (unsigned t = 0; t < threads; t++)
+            w[t] = (build_worker){.c = c,
+                                  .lo = texels / threads * t,
+                                  .hi = t + 1 == threads ? texels : texels / threads * (t + 1),
+                                  .maps = maps,
+                                  .nmaps = n};
+        run_all(merge_run, w, threads);
+        m->top = maps[0];
+    }
+    for (unsigned t = rc == 0; t < n; t++)
+        big_free(maps[t], map_bytes(texels));
+    return rc;
 }
 
 unsigned shadow_map_depth(const oct_tree *tree, unsigned up)
@@ -280,7 +321,7 @@ unsigned shadow_map_depth(const oct_tree *tree, unsigned up)
 
 unsigned shadow_map_up_for(const oct_tree *tree, uint64_t pixels)
 {
-    return tree->levels <= SHADOW_MAP_MAX_DEPTH && pixels >= 2u * tree->voxel_count
+    return tree->levels <= SHADOW_MAP_MAX_DEPTH && pixels >= tree->voxel_count
                ? SHADOW_MAP_FINE
                : SHADOW_MAP_COARSE;
 }
@@ -330,9 +371,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
     m->inv_texel = 1.0 / side;
     m->nu = (uint32_t)((uhi + 1.0 - m->u0) * m->inv_texel) + 3u;
     m->nv = (uint32_t)((vhi + 1.0 - m->v0) * m->inv_texel) + 3u;
-    m->top = empty_map((size_t)m->nu * m->nv);
-    if (!m->top)
-        return -1;
+    m->top = NULL;
     const double *axes[3] = {m->u, m->v, m->w};
     for (unsigned d = 0; d + 1u < c.depth; d++) /* child k's corner from its parent's */
         for (unsigned k = 0; k < 8; k++)
@@ -373,12 +412,11 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
         }
         c.box[mask].top = hi[2];
     }
-    if (tree->node_count[0] && put_cells(&c, threads ? threads : 1u) != 0) {
-        shadow_map_free(m);
-        return -1;
+    if (!tree->node_count[0]) { /* no cell: every texel -inf */
+        m->top = empty_map(map_texels(m));
+        return m->top ? 0 : -1;
     }
-    finish(m);
-    return 0;
+    return put_cells(&c, m, threads ? threads : 1u);
 }
 
 void shadow_map_free(shadow_map *m)

@@ -395,15 +395,15 @@ static void test_lit_at_start_same_answers(void **state)
     tree_util_free(t);
 }
 
-/* The map worth making: the fine one from two pixels a voxel on. */
+/* The map worth making: the fine one from one pixel a voxel on. */
 static void test_map_resolution_rule(void **state)
 {
     (void)state;
     uint32_t xyz[3][3] = {{1, 1, 1}, {5, 2, 7}, {3, 3, 3}};
     oct_tree *t = tree_util_simple(4, (const uint32_t(*)[3])xyz, 3);
     assert_non_null(t);
-    assert_int_equal(shadow_map_up_for(t, 5), SHADOW_MAP_COARSE);
-    assert_int_equal(shadow_map_up_for(t, 6), SHADOW_MAP_FINE);
+    assert_int_equal(shadow_map_up_for(t, 2), SHADOW_MAP_COARSE);
+    assert_int_equal(shadow_map_up_for(t, 3), SHADOW_MAP_FINE);
     assert_int_equal(shadow_map_depth(t, SHADOW_MAP_FINE), 4);
     assert_int_equal(shadow_map_depth(t, SHADOW_MAP_COARSE), 2);
     assert_int_equal(shadow_map_depth(t, 7), 1); /* at least the root's children */

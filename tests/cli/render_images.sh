@@ -70,19 +70,19 @@ cmp -s "$T/v2.png" "$T/v2b.png" || fail "views line differs from the same comman
 
 # shadows under one light over many views (a shadow map of voxels, made once
 # and asked where the rays start) give the images of each view alone (a
-# map of coarser cells): four 96x96 views are over two pixels a voxel here,
+# map of coarser cells): four 88x88 views are over one pixel a voxel here,
 # one is under (shadow_map_up_for)
 nvox=$("$BIN/rasterize" "$ROOT/scenes/torus.scene" -o "$T/t2.oct" --levels 6 2>&1 |
     sed -n 's/.*), \([0-9]*\) voxels,.*/\1/p')
-[ -n "$nvox" ] && [ "$nvox" -gt 4608 ] && [ "$nvox" -le 18432 ] ||
+[ -n "$nvox" ] && [ "$nvox" -gt 7744 ] && [ "$nvox" -le 30976 ] ||
     fail "shadows: $nvox voxels: the views below do not choose both maps"
 printf '%s\n' "-o $T/s1.png" "-o $T/s2.png --eye 2,-1.5,1" "-o $T/s3.png --exact" \
     "-o $T/s4.png --eye -1,2,1.5 --exact" >"$T/sh.views"
-expect_exit 0 "$R" "$T/t.oct" --views "$T/sh.views" --size 96x96 --shadows --light 0.3,0.4,0.85 -q
+expect_exit 0 "$R" "$T/t.oct" --views "$T/sh.views" --size 88x88 --shadows --light 0.3,0.4,0.85 -q
 for v in "1:" "2:--eye 2,-1.5,1" "3:--exact" "4:--eye -1,2,1.5 --exact"; do
     k=${v%%:*}
     # shellcheck disable=SC2086 # the view's options split into words
-    expect_exit 0 "$R" "$T/t.oct" -o "$T/s${k}b.png" ${v#*:} --size 96x96 --shadows \
+    expect_exit 0 "$R" "$T/t.oct" -o "$T/s${k}b.png" ${v#*:} --size 88x88 --shadows \
         --light 0.3,0.4,0.85 -q
     cmp -s "$T/s$k.png" "$T/s${k}b.png" || fail "shadows: view $k of a run differs from it alone"
 done
