@@ -57,9 +57,9 @@ typedef struct frame_job {
 /* What a run of frames keeps from one to the next (render's views loop):
  * the light's shadow map, made again only for another light or when a
  * finer one is wanted (shadow_map_cached), and the antialiasing pass's
- * tile border probes,
- * grown as the images do (a mapping made anew each frame costs a page
- * fault a page). Zeroed to start; frame_keep_free at the end. */
+ * tile border probes, grown as the images do (a mapping made anew each
+ * frame costs a page fault a page). Zeroed to start; frame_keep_free at
+ * the end. */
 typedef struct frame_keep {
     shadow_map_cache maps;
     aa_probe *border;      /* border_tiles tiles' probes, or NULL */

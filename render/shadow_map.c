@@ -287,15 +287,15 @@ static int put_cells(build_ctx *c, shadow_map *m, unsigned threads)
         w[t] = (build_worker){.c = c};
     run_all(walk_run, w, threads);
     free(c->split);
-    /* the maps that were made, this thread's first (a thread that could not
-       make one took no subtree) */
+    /* the maps that were made (a thread that could not make one took no
+       subtree: the others took them all) */
     float *maps[8];
     unsigned n = 0;
     for (unsigned t = 0; t < threads; t++)
         if (w[t].top)
             maps[n++] = w[t].top;
     int rc = 0;
-    if (!w[0].top || n == 0) {
+    if (n == 0) {
         rc = -1;
     } else {
         for (unsigned t = 0; t < threads; t++)
