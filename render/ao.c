@@ -63,12 +63,13 @@ void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, doubl
 }
 
 /* The unoccluded fraction of the rays k0 .. k0 + count - 1 from the grid
- * position e, started at anchor an. */
+ * position e, started at anchor an, each reach cube edges long. */
 static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                            const trace_eye *e, const trace_anchor *an, const float n[3],
-                           unsigned k0, unsigned count, unsigned m, uint32_t seed, uint64_t *steps)
+                           unsigned k0, unsigned count, unsigned m, uint32_t seed, double reach,
+                           uint64_t *steps)
 {
-    const double dist = AO_DISTANCE * tree->edge;
+    const double dist = reach * tree->edge;
     ao_frame f;
     ao_basis(n, seed, &f);
     unsigned open = 0;
@@ -95,7 +96,7 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
 
 float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                 const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
-                uint32_t seed, uint64_t *steps)
+                uint32_t seed, double reach, uint64_t *steps)
 {
     /* the rays share their start: its grid position once, and the deepest
        occupied cell around it, where every ray's descent would arrive */
@@ -113,14 +114,15 @@ float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn 
         }
         trace_anchor_find(tree, lo, hi, &an);
     }
-    return open_fraction(tree, opts, traverse, &e, &an, n, k0, count, m, seed, steps);
+    return open_fraction(tree, opts, traverse, &e, &an, n, k0, count, m, seed, reach, steps);
 }
 
 float ao_factor_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                      const shadow_start *s, const float n[3], unsigned k0, unsigned count,
-                     unsigned m, uint32_t seed, uint64_t *steps)
+                     unsigned m, uint32_t seed, double reach, uint64_t *steps)
 {
     if (!s->eye.ok)
         return 1.0f;
-    return open_fraction(tree, opts, traverse, &s->eye, &s->anchor, n, k0, count, m, seed, steps);
+    return open_fraction(tree, opts, traverse, &s->eye, &s->anchor, n, k0, count, m, seed, reach,
+                         steps);
 }

@@ -1,7 +1,8 @@
 /* ao: ambient occlusion. From the start point of render/shadow.h, rays over
- * the hemisphere of the viewer-facing normal, cosine-weighted, each up to
- * AO_DISTANCE (a fraction of the cube's edge); the ambient term is scaled
- * by the fraction that meet nothing (RENDER.md, "Ambient occlusion").
+ * the hemisphere of the viewer-facing normal, cosine-weighted, each up to a
+ * distance given as a fraction of the cube's edge (--ao-distance, 1/8 by
+ * default); the ambient term is scaled by the fraction that meet nothing
+ * (RENDER.md, "Ambient occlusion").
  *
  * Directions: ray k of M is u_k = (k + 1/2) / M (stratified in cos^2 of the
  * angle to the normal: cosine weighting), azimuth 2 pi frac(k phi) + 2 pi s
@@ -19,7 +20,6 @@
 #include "render/trace.h"
 #include "render/trace_impl.h"
 
-#define AO_DISTANCE 0.125 /* ray length, in cube edges */
 #define AO_MAX_RAYS 4096  /* --ao 0..AO_MAX_RAYS */
 
 /* The per-pixel rotation seed of pixel (i, j) (a 32-bit hash). */
@@ -40,11 +40,12 @@ void ao_basis(const float n[3], uint32_t seed, ao_frame *f);
 void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, double d[3]);
 
 /* The unoccluded fraction of rays k0 .. k0 + count - 1 of M from the world
- * point o (shadow_origin's) over unit n: (rays meeting nothing) / count,
- * count >= 1. Adds the rays' DDA steps to *steps. */
+ * point o (shadow_origin's) over unit n, each `reach` cube edges long:
+ * (rays meeting nothing) / count, count >= 1. Adds the rays' DDA steps to
+ * *steps. */
 float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                 const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
-                uint32_t seed, uint64_t *steps);
+                uint32_t seed, double reach, uint64_t *steps);
 
 struct shadow_start; /* render/shadow.h */
 
@@ -52,6 +53,6 @@ struct shadow_start; /* render/shadow.h */
  * started at its anchor: the same factor and steps. */
 float ao_factor_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                      const struct shadow_start *s, const float n[3], unsigned k0, unsigned count,
-                     unsigned m, uint32_t seed, uint64_t *steps);
+                     unsigned m, uint32_t seed, double reach, uint64_t *steps);
 
 #endif

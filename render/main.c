@@ -38,7 +38,7 @@ static const char usage_text[] =
     "usage: render FILE.oct -o OUT.png [--size WxH] [--eye X,Y,Z] [--target X,Y,Z]\n"
     "              [--up X,Y,Z] [--fov DEG] [--depth OUT.pfm] [--normals OUT.png]\n"
     "              [--split K] [--refine] [--exact] [--light X,Y,Z] [--background R,G,B]\n"
-    "              [--aa N] [--alpha] [--shadows] [--ao N]\n"
+    "              [--aa N] [--alpha] [--shadows] [--ao N] [--ao-distance F]\n"
     "              [--beam N] [--threads N] [--trust] [--info] [-q] [-v]\n"
     "       render FILE.oct --views VIEWS_FILE [--part I/N] [options]\n"
     "       render FILE.oct -o 'frame_%04d.png' --orbit N [--part I/N] [options]\n"
@@ -67,8 +67,9 @@ static const char help_text[] =
     "                      a neighbour's, 1.." LIMIT_STR(VIEWS_AA_MAX) " (default 1: one ray a pixel)\n"
     "  --alpha             RGBA PNG, alpha = the fraction of the pixel's samples that hit\n"
     "  --shadows           one shadow ray per lit hit towards --light\n"
-    "  --ao N              ambient occlusion: N rays over each hit's hemisphere, up to\n"
-    "                      1/8 of the cube's edge, 0.." LIMIT_STR(VIEWS_AO_MAX) " (default 0: off)\n"
+    "  --ao N              ambient occlusion: N rays over each hit's hemisphere,\n"
+    "                      0.." LIMIT_STR(VIEWS_AO_MAX) " (default 0: off)\n"
+    "  --ao-distance F     the AO rays' length in cube edges, (0, " LIMIT_STR(VIEWS_AO_DISTANCE_MAX) "] (default 0.125)\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
     "  --background R,G,B  linear colour of rays that miss, 0..1 each (default 0,0,0)\n"
     "  --threads N         worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: online CPUs, at most "
@@ -429,6 +430,7 @@ static int render_view(const oct_tree *tree, const render_args *o, const views_v
     job.shade.shadows = v->shadows;
     job.keep = keep;
     job.shade.ao_rays = (unsigned)v->ao;
+    job.shade.ao_distance = v->ao_distance;
     job.timing = o->verbose;
     if (!o->quiet && diag_stderr_is_tty())
         job.progress = progress_bar;

@@ -15,6 +15,7 @@ typedef struct shade_params {
     float ambient;        /* 0..1, share of the colour lit regardless of the light */
     int shadows;          /* 1: one shadow ray per lit hit (render/shadow.h) */
     unsigned ao_rays;     /* ambient occlusion rays per hit (render/ao.h); 0: none */
+    double ao_distance;   /* their length, in cube edges (> 0 when ao_rays > 0) */
 } shade_params;
 
 /* The default light: from over the viewer's (left) shoulder. */

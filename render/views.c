@@ -21,10 +21,12 @@ void views_defaults(views_view *v)
     v->width = 512;
     v->height = 512;
     v->aa = 1;
+    v->ao_distance = VIEWS_AO_DISTANCE;
 }
 
 static const char *const value_opts[] = {"-o", "--eye", "--target", "--up", "--fov",
-                                         "--size", "--depth", "--normals", "--aa", "--ao"};
+                                         "--size", "--depth", "--normals", "--aa", "--ao",
+                                         "--ao-distance"};
 
 int views_is_option(const char *name)
 {
@@ -89,6 +91,13 @@ int views_apply(views_view *v, const char *name, const char *value, char *msg, s
         e = parse_long(value, 1, VIEWS_AA_MAX, &v->aa);
     } else if (strcmp(name, "--ao") == 0) {
         e = parse_long(value, 0, VIEWS_AO_MAX, &v->ao);
+    } else if (strcmp(name, "--ao-distance") == 0) {
+        e = parse_double(value, &v->ao_distance);
+        if (e == PARSE_OK && !(v->ao_distance > 0.0 && v->ao_distance <= VIEWS_AO_DISTANCE_MAX)) {
+            snprintf(msg, n, "--ao-distance: %s: must be in (0, " LIMIT_STR(VIEWS_AO_DISTANCE_MAX)
+                             "] cube edges", value);
+            return -1;
+        }
     } else {
         snprintf(msg, n, "unknown option '%s'", name);
         return -1;

@@ -6,7 +6,7 @@
  * value syntax as the command line:
  *     -o OUT.png [--eye X,Y,Z] [--target X,Y,Z] [--up X,Y,Z] [--fov DEG]
  *     [--size WxH] [--depth OUT.pfm] [--normals OUT.png] [--exact]
- *     [--aa N] [--ao N] [--alpha] [--shadows]
+ *     [--aa N] [--ao N] [--ao-distance F] [--alpha] [--shadows]
  * Options a line leaves out take the command line's values (or the
  * defaults). Paths cannot contain whitespace or '#'. Every line needs -o.
  * Relative paths are taken as they are (relative to the working directory). */
@@ -25,6 +25,7 @@ typedef struct views_view {
     const char *normals; /* PNG path or NULL */
     long aa;             /* 1..VIEWS_AA_MAX samples a side where needed */
     long ao;             /* ambient occlusion rays, 0..VIEWS_AO_MAX */
+    double ao_distance;  /* their length in cube edges, (0, VIEWS_AO_DISTANCE_MAX] */
     int alpha, shadows;  /* flags */
     int exact;           /* --exact: hits placed by the stored functions */
     unsigned line;       /* views-file line (1-based), 0 for the command line */
@@ -32,9 +33,12 @@ typedef struct views_view {
 
 #define VIEWS_AA_MAX 16    /* render/aa.h's AA_MAX */
 #define VIEWS_AO_MAX 4096  /* render/ao.h's AO_MAX_RAYS */
+#define VIEWS_AO_DISTANCE 0.125  /* --ao-distance's default: 1/8 of the cube's edge */
+#define VIEWS_AO_DISTANCE_MAX 2 /* past the cube's diagonal (sqrt 3): no limit */
 
-/* The built-in defaults: 512x512, up 0,0,1, fov 30; eye and target unset
- * (the caller frames the cube); no outputs. */
+/* The built-in defaults: 512x512, up 0,0,1, fov 30, AO rays 1/8 of the
+ * cube's edge long; eye and target unset (the caller frames the cube); no
+ * outputs. */
 void views_defaults(views_view *v);
 
 /* 1 when `name` is a per-view option that takes a value. */

@@ -20,6 +20,7 @@
 #include "common/view/image.h"
 #include "render/aa.h"
 #include "render/frame.h"
+#include "render/views.h"
 #include "tests/voxel_shapes.h"
 
 #define W 80
@@ -472,6 +473,7 @@ static void test_packets_same_image(void **state)
             job.shade.ambient = 0.2f;
             job.shade.shadows = aa % 2;
             job.shade.ao_rays = aa == 4 ? 8 : 0;
+            job.shade.ao_distance = VIEWS_AO_DISTANCE;
             shade_default_light(cams[sc], job.shade.light);
             job.beam_size = FRAME_BEAM_DEFAULT;
             job.aa = aa;

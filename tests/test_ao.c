@@ -1,7 +1,8 @@
 /* Tests for render/ao: directions on the normal's side, unit, the same for
  * the same pixel; a plane alone is open (factor 1, exactly); the inside of
- * a concave corner is darker than its open floor; the frame's AO image is
- * the same on every traversal implementation and thread count. */
+ * a concave corner is darker than its open floor, and lighter with shorter
+ * rays; the frame's AO image is the same on every traversal implementation
+ * and thread count. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,12 +17,14 @@
 #include "format/oct_normal.h"
 #include "render/ao.h"
 #include "render/frame.h"
+#include "render/views.h"
 #include "render/shadow.h"
 #include "tests/grid_hits.h"
 #include "tests/voxel_shapes.h"
 
 #define LEVELS 6
 #define NV 64.0
+#define REACH VIEWS_AO_DISTANCE /* the default --ao-distance: 8 voxels here */
 
 static void test_directions(void **state)
 {
@@ -47,10 +50,11 @@ static void test_directions(void **state)
     assert_true(ao_seed(0, 0) != ao_seed(1, 0));
 }
 
-/* The AO factor of the surface point under (x, y), looked at from above;
- * -1 when there is none. */
-static float factor_at(const oct_tree *t, const trace_opts *o, trace_traverse_fn fn, double x,
-                       double y, unsigned rays)
+/* The AO factor of rays k0 .. k0 + count - 1 of `rays`, each `reach` cube
+ * edges long, from the surface point under (x, y), looked at from above; -1
+ * when there is none. */
+static float factor_of(const oct_tree *t, const trace_opts *o, trace_traverse_fn fn, double x,
+                       double y, unsigned k0, unsigned count, unsigned rays, double reach)
 {
     const double eye[3] = {x, y, NV - 0.5}, down[3] = {0, 0, -1};
     trace_hit h;
@@ -64,7 +68,15 @@ static float factor_at(const oct_tree *t, const trace_opts *o, trace_traverse_fn
     double org[3];
     assert_true(shadow_origin(t, &h, n, org));
     uint64_t steps = 0;
-    return ao_factor(t, o, fn, org, n, 0, rays, rays, ao_seed((uint32_t)x, (uint32_t)y), &steps);
+    return ao_factor(t, o, fn, org, n, k0, count, rays, ao_seed((uint32_t)x, (uint32_t)y), reach,
+                     &steps);
+}
+
+/* factor_of for all the rays, at the default length. */
+static float factor_at(const oct_tree *t, const trace_opts *o, trace_traverse_fn fn, double x,
+                       double y, unsigned rays)
+{
+    return factor_of(t, o, fn, x, y, 0, rays, rays, REACH);
 }
 
 static void test_plane_alone_is_open(void **state)
@@ -106,7 +118,7 @@ static void test_concave_corner_is_darker(void **state)
         for (int refine = 0; refine <= 1; refine++) {
             trace_opts o = {.split = LEVELS, .refine = refine};
             trace_traverse_fn fn = trace_impls[impl].traverse;
-            /* AO_DISTANCE is 8 voxels here: open beyond it, dark near the wall */
+            /* the rays go 8 voxels here: open beyond them, dark near the wall */
             const float open = factor_at(t, &o, fn, 40.5, 30.5, 256);
             const float mid = factor_at(t, &o, fn, 25.5, 30.5, 256);
             const float corner = factor_at(t, &o, fn, 22.5, 30.5, 256);
@@ -115,6 +127,46 @@ static void test_concave_corner_is_darker(void **state)
             assert_true(corner < mid);
             assert_true(corner < 0.85f);
         }
+    tree_util_free(t);
+}
+
+/* --ao-distance: each ray's answer over a shorter length is its answer over
+ * the first part of a longer one (open there when open all along), so no
+ * ray of the corner's floor is occluded at a short length and open at a
+ * longer one; rays too short to reach the wall leave the floor open
+ * (factor 1 exactly), and the corner is still darker up close. */
+static void test_shorter_reach_is_lighter(void **state)
+{
+    (void)state;
+    shape sh[2] = {shape_plane(0, 0, 1, 20.5), shape_plane(1, 0, 0, 20.5)};
+    sh[0].lo[0] = 20;
+    sh[1].lo[2] = 20;
+    oct_tree *t = shapes_build(LEVELS, NV, sh, 2, 1);
+    assert_non_null(t);
+    static const double reach[] = {1.0 / 64, 3.0 / 64, REACH, 0.5, 2.0}; /* 1, 3, 8 voxels, ... */
+    enum { RAYS = 32, NR = sizeof reach / sizeof reach[0] };
+    unsigned long turned = 0; /* rays open at one length and occluded at the next */
+    for (unsigned impl = 0; impl < trace_impl_count; impl++)
+        for (int refine = 0; refine <= 1; refine++) {
+            trace_opts o = {.split = LEVELS, .refine = refine};
+            trace_traverse_fn fn = trace_impls[impl].traverse;
+            for (double x = 21.3; x < 34; x += 0.9)
+                for (unsigned k = 0; k < RAYS; k++) {
+                    float prev = 1.0f;
+                    for (unsigned r = 0; r < NR; r++) {
+                        const float f = factor_of(t, &o, fn, x, 30.5, k, 1, RAYS, reach[r]);
+                        assert_true(f == 0.0f || f == 1.0f);
+                        assert_true(f <= prev); /* occluded stays occluded */
+                        turned += f < prev;
+                        prev = f;
+                    }
+                }
+            /* 5 voxels from the wall: 3-voxel rays reach nothing, 8-voxel ones do */
+            assert_true(factor_of(t, &o, fn, 25.5, 30.5, 0, 256, 256, 3.0 / 64) == 1.0f);
+            assert_true(factor_of(t, &o, fn, 25.5, 30.5, 0, 256, 256, REACH) < 1.0f);
+            assert_true(factor_of(t, &o, fn, 22.5, 30.5, 0, 256, 256, 3.0 / 64) < 1.0f);
+        }
+    assert_true(turned > 100);
     tree_util_free(t);
 }
 
@@ -128,6 +180,7 @@ static void render_ao(const oct_tree *t, const camera *cam, trace_traverse_fn fn
     job.opts.split = LEVELS;
     job.shade.ambient = 0.3f;
     job.shade.ao_rays = 16;
+    job.shade.ao_distance = REACH;
     job.shade.shadows = 1;
     shade_default_light(cam, job.shade.light);
     job.rgb = rgb;
@@ -206,8 +259,9 @@ static void test_shared_start_same_answers(void **state)
                     deep += st.anchor.depth + 2 >= LEVELS;
                     const uint32_t seed = ao_seed((uint32_t)x, (uint32_t)y);
                     uint64_t s0 = 0, s1 = 0;
-                    const float f0 = ao_factor(t, &o, fn, org, n, 0, 16, 16, seed, &s0);
-                    const float f1 = ao_factor_from(t, &o, fn, &st, n, 0, 16, 16, seed, &s1);
+                    const float f0 = ao_factor(t, &o, fn, org, n, 0, 16, 16, seed, REACH, &s0);
+                    const float f1 =
+                        ao_factor_from(t, &o, fn, &st, n, 0, 16, 16, seed, REACH, &s1);
                     assert_true(f0 == f1);
                     assert_true(s0 == s1);
                     shaded += f0 < 1.0f;
@@ -237,6 +291,7 @@ int main(void)
         cmocka_unit_test(test_directions),
         cmocka_unit_test(test_plane_alone_is_open),
         cmocka_unit_test(test_concave_corner_is_darker),
+        cmocka_unit_test(test_shorter_reach_is_lighter),
         cmocka_unit_test(test_frame_ao_deterministic),
         cmocka_unit_test(test_shared_start_same_answers),
     };

@@ -1,5 +1,5 @@
 #!/bin/sh
-# render --aa, --alpha, --shadows, --ao, -v: bad values (exit 2, a message,
+# render --aa, --alpha, --shadows, --ao, --ao-distance, -v: bad values (exit 2, a message,
 # no output), RGBA output, per-view options in views files, the same bytes
 # whatever the thread count.
 . "$ROOT/tests/cli/lib.sh"
@@ -21,14 +21,21 @@ bad "(1..16)" -o "$T/o.png" --aa 17
 bad "--ao: '-1'" -o "$T/o.png" --ao -1
 bad "--ao: '100000'" -o "$T/o.png" --ao 100000
 bad "--ao: '1e9'" -o "$T/o.png" --ao 1e9
+bad "--ao-distance: 0: must be in (0, 2] cube edges" -o "$T/o.png" --ao 4 --ao-distance 0
+bad "--ao-distance: -0.1: must be in (0, 2] cube edges" -o "$T/o.png" --ao 4 --ao-distance -0.1
+bad "--ao-distance: 2.5: must be in (0, 2] cube edges" -o "$T/o.png" --ao 4 --ao-distance 2.5
+bad "--ao-distance: 'x': not a number" -o "$T/o.png" --ao 4 --ao-distance x
+bad "--ao-distance: 'nan': not a number" -o "$T/o.png" --ao 4 --ao-distance nan
 bad "--alpha: " -o "$T/o.ppm" --alpha
 bad "--light: 0,0,0" -o "$T/o.png" --light 0,0,0
 bad "--light: 'nan,0,1'" -o "$T/o.png" --light nan,0,1
 bad "--light: 'inf,0,1'" -o "$T/o.png" --light inf,0,1
-printf '%s\n' "-o $T/o.png --aa 2" "-o $T/o2.png --ao -3" "-o $T/o.ppm --alpha" >"$T/bad.views"
+printf '%s\n' "-o $T/o.png --aa 2" "-o $T/o2.png --ao -3" "-o $T/o.ppm --alpha" \
+    "-o $T/o3.png --ao 2 --ao-distance 3" >"$T/bad.views"
 expect_exit 2 "$R" "$T/t.oct" --views "$T/bad.views"
 expect_err "bad.views:2: --ao"
 expect_err "bad.views:3: --alpha"
+expect_err "bad.views:4: --ao-distance: 3: must be in (0, 2] cube edges"
 [ -e "$T/o.png" ] && fail "a view of a bad views file was rendered"
 
 # a finite light whose square overflows is still a direction
@@ -41,6 +48,18 @@ expect_exit 0 "$R" "$T/t.oct" -o "$T/a.png" --size 64x48 --aa 4 --alpha
 expect_err "supersampled"
 expect_exit 0 "$R" "$T/t.oct" -o "$T/p.png" --size 64x48 --aa 4
 [ "$(ctype "$T/p.png")" = 2 ] || fail "no --alpha: not an RGB PNG"
+
+# --ao-distance: the default's own value changes nothing, a much shorter one
+# changes the image (test_ao.c checks it lightens ray by ray); per view too
+expect_exit 0 "$R" "$T/t.oct" -o "$T/ao.png" --size 64x48 --ao 16 -q
+expect_exit 0 "$R" "$T/t.oct" -o "$T/ao8.png" --size 64x48 --ao 16 --ao-distance 0.125 -q
+cmp -s "$T/ao.png" "$T/ao8.png" || fail "--ao-distance 0.125 is not the default"
+expect_exit 0 "$R" "$T/t.oct" -o "$T/ao1.png" --size 64x48 --ao 16 --ao-distance 0.01 -q
+cmp -s "$T/ao.png" "$T/ao1.png" && fail "--ao-distance 0.01 changed nothing"
+printf '%s\n' "-o $T/vd1.png --ao 16 --ao-distance 0.01" "-o $T/vd2.png --ao 16" >"$T/d.views"
+expect_exit 0 "$R" "$T/t.oct" --views "$T/d.views" --size 64x48 -q
+cmp -s "$T/vd1.png" "$T/ao1.png" || fail "views: --ao-distance not per view"
+cmp -s "$T/vd2.png" "$T/ao.png" || fail "views: --ao-distance leaked to the next line"
 
 # -v: rays of each kind
 expect_exit 0 "$R" "$T/t.oct" -o "$T/v.png" --size 64x48 --shadows --ao 4 -v
