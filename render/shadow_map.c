@@ -179,6 +179,8 @@ static void walk(const build_ctx *c, walk_out *out, unsigned d, unsigned stop,
     }
 }
 
+#define BUILD_THREADS 8 /* at most: the build's threads and maps */
+
 /* A thread of the build: first its share of the subtrees into a map of its
  * own, then its range of texels of the merge. */
 typedef struct build_worker {
@@ -250,8 +252,8 @@ static void *merge_run(void *arg)
  * their own where they can be started, else here after w[0]. */
 static void run_all(void *(*fn)(void *), build_worker *w, unsigned n)
 {
-    pthread_t tid[8];
-    int started[8] = {0};
+    pthread_t tid[BUILD_THREADS];
+    int started[BUILD_THREADS] = {0};
     for (unsigned t = 1; t < n; t++)
         started[t] = pthread_create(&tid[t], NULL, fn, &w[t]) == 0;
     fn(&w[0]);
@@ -278,18 +280,18 @@ static int put_cells(build_ctx *c, shadow_map *m, unsigned threads)
     walk(c, &out, 0, d, &root);
     c->nsplit = out.count;
     atomic_init(&c->next, 0);
-    if (threads > 8)
-        threads = 8;
+    if (threads > BUILD_THREADS)
+        threads = BUILD_THREADS;
     if ((size_t)threads > c->nsplit)
         threads = c->nsplit ? (unsigned)c->nsplit : 1u;
-    build_worker w[8];
+    build_worker w[BUILD_THREADS];
     for (unsigned t = 0; t < threads; t++)
         w[t] = (build_worker){.c = c};
     run_all(walk_run, w, threads);
     free(c->split);
     /* the maps that were made (a thread that could not make one took no
        subtree: the others took them all) */
-    float *maps[8];
+    float *maps[BUILD_THREADS];
     unsigned n = 0;
     for (unsigned t = 0; t < threads; t++)
         if (w[t].top)
@@ -421,7 +423,7 @@ int shadow_map_build(const oct_tree *tree, const double light[3], unsigned up, u
 
 void shadow_map_free(shadow_map *m)
 {
-    big_free(m->top, map_bytes((size_t)m->nu * m->nv));
+    big_free(m->top, map_bytes(map_texels(m)));
     m->top = NULL;
 }
 

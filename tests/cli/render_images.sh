@@ -37,6 +37,7 @@ expect_err "bad.views:2: --ao"
 expect_err "bad.views:3: --alpha"
 expect_err "bad.views:4: --ao-distance: 3: must be in (0, 2] cube edges"
 [ -e "$T/o.png" ] && fail "a view of a bad views file was rendered"
+[ -e "$T/o3.png" ] && fail "a view of a bad views file was rendered"
 
 # a finite light whose square overflows is still a direction
 expect_exit 0 "$R" "$T/t.oct" -o "$T/big.png" --size 32x32 --light 1e300,1e300,1e300 --shadows -q
