@@ -2,6 +2,8 @@
  * rounding and flag rules). */
 #include "common/expr/interval.h"
 
+#include "common/expr/exp_kernel.h"
+
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -106,7 +108,7 @@ interval interval_exp(interval a, unsigned *flags)
 {
     if (isnan_iv(a))
         return nan_iv(flags);
-    double l = dn2_pos(exp(a.lo)), h = up2_pos(exp(a.hi));
+    double l = dn2_pos(exp_kernel(a.lo)), h = up2_pos(exp_kernel(a.hi));
     /* Widen subnormal ends to 0 and DBL_MIN: exp of a large negative
      * number would otherwise feed subnormals, which are ~100 times slower
      * on x86, into everything downstream (blobs_b's exp(-196*...)). */

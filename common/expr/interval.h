@@ -16,9 +16,10 @@
  * outward, the lower end down and the upper end up, by steps of at least
  * one ulp (interval_next_down / interval_next_up): one step for + - * /
  * sqrt (IEEE 754 rounds these correctly, so the true value is within half
- * an ulp), two steps for the libm functions exp log sin cos tan pow (glibc
- * documents at most 1-2 ulp for these; see also the MPFR cross-checks in
- * tests/test_interval.c). Each operation below states its rounding. We do not
+ * an ulp), two steps for exp (our own, exp_kernel.h: below one ulp, measured
+ * against MPFR in tests/test_exp.c) and the libm functions log sin cos tan
+ * pow (glibc documents at most 1-2 ulp for these; see also the MPFR
+ * cross-checks in tests/test_interval.c). Each operation below states its rounding. We do not
  * use fesetround: it needs -frounding-math to stop the compiler from folding
  * and moving floating-point code across the mode switch, it is slow to toggle,
  * it is per-thread state, and it says nothing about libm's accuracy anyway.
@@ -50,7 +51,8 @@ interval interval_div(interval a, interval b, unsigned *flags);
 /* sqrt(a), ends rounded one step outward, the lower end clamped at 0. The
  * negative part of a is flagged and dropped; all of a negative is NaN. */
 interval interval_sqrt(interval a, unsigned *flags);
-/* exp(a), ends rounded two steps outward. Overflow gives +inf, never NaN;
+/* exp(a), ends rounded two steps outward (exp_kernel.h's e^x, below one ulp
+ * from the true value: docs/NUMERICS.md). Overflow gives +inf, never NaN;
  * subnormal ends widen to 0 (lower) and DBL_MIN (upper). */
 interval interval_exp(interval a, unsigned *flags);
 /* log(a), ends rounded two steps outward. log(0) = -inf (a value, not NaN);

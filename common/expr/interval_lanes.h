@@ -10,46 +10,36 @@
 #define INTERVAL_LANES_H
 
 #include <stdint.h>
-#include <string.h>
 
-static inline uint64_t il_bits(double x)
-{
-    uint64_t u;
-    memcpy(&u, &x, sizeof u);
-    return u;
-}
-static inline double il_double(uint64_t u)
-{
-    double x;
-    memcpy(&x, &u, sizeof x);
-    return x;
-}
+#include "common/expr/double_bits.h"
+
 /* 1 when x is neither infinite nor NaN, else 0 (a quiet test). */
-static inline uint64_t il_finite(double x) { return ((il_bits(x) >> 52) & 0x7ff) != 0x7ff; }
+static inline uint64_t il_finite(double x) { return ((double_bits(x) >> 52) & 0x7ff) != 0x7ff; }
 /* 1 when x is finite and |x| >= DBL_MIN (not 0, not subnormal), else 0. */
-static inline uint64_t il_normal(double x) { return ((il_bits(x) >> 52) & 0x7ff) - 1 < 0x7fe; }
+static inline uint64_t il_normal(double x) { return ((double_bits(x) >> 52) & 0x7ff) - 1 < 0x7fe; }
 /* interval__up_finite and interval__down_finite of such a normal x: the
  * bit step alone. */
 static inline double il_step_up(double x)
 {
-    uint64_t u = il_bits(x);
-    return il_double(u + (1 - ((u >> 63) << 1)));
+    uint64_t u = double_bits(x);
+    return bits_double(u + (1 - ((u >> 63) << 1)));
 }
 static inline double il_step_down(double x)
 {
-    uint64_t u = il_bits(x);
-    return il_double(u - (1 - ((u >> 63) << 1)));
+    uint64_t u = double_bits(x);
+    return bits_double(u - (1 - ((u >> 63) << 1)));
 }
 /* m ? a : b for m 0 or 1, on the bit patterns (vector code without
  * branches). */
 static inline double il_sel(uint64_t m, double a, double b)
 {
-    return il_double((il_bits(a) & (0 - m)) | (il_bits(b) & (m - 1)));
+    return bits_double((double_bits(a) & (0 - m)) | (double_bits(b) & (m - 1)));
 }
 static inline double il_min(double a, double b) { return a < b ? a : b; } /* as interval__min2 */
 static inline double il_max(double a, double b) { return a > b ? a : b; }
 
 
+#include "common/expr/exp_kernel.h"
 #include "common/expr/interval.h"
 
 /* interval_add(a, b) where its fast path applies; *ok becomes 0 where it
@@ -62,8 +52,22 @@ static inline interval il_add(interval a, interval b, uint64_t *ok)
     return r;
 }
 
+/* interval_exp of [lo, hi] where its plain path applies: both ends' e^x
+ * (exp_kernel) normal and two bit steps from the limits, the lower at least
+ * 2^-1021 and the upper below 2^1023; the result is then their two bit steps
+ * outward (dn2_pos, up2_pos), returned with 1, else 0 (*rl, *rh are then not
+ * interval_exp's; a NaN end fails the test). */
+static inline __attribute__((always_inline)) uint64_t il_exp_ends(double lo, double hi, double *rl, double *rh)
+{
+    const uint64_t el = double_bits(exp_kernel(lo)), eh = double_bits(exp_kernel(hi));
+    const uint64_t min_lo = double_bits(0x1p-1021), min_hi = double_bits(0x1p-1022);
+    *rl = bits_double(el - 2);
+    *rh = bits_double(eh + 2);
+    return (el - min_lo < double_bits(INFINITY) - min_lo) & (eh - min_hi < double_bits(0x1p1023) - min_hi);
+}
+
 /* 1 when x is +0 or -0. */
-static inline uint64_t il_zero(double x) { return (il_bits(x) << 1) == 0; }
+static inline uint64_t il_zero(double x) { return (double_bits(x) << 1) == 0; }
 
 /* interval_mul(a, b) likewise; with finite ends, a factor that is exactly
  * [0, 0] gives interval_mul's [+0, +0] (a zero end from a zero factor stays

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/expr/exp_kernel.h"
 #include "common/expr/tape_int.h"
 
 struct tape_builder {
@@ -205,7 +206,7 @@ static double point_op(tape_op op, double a, double c, double p)
     case TAPE_NEG: return -a;
     case TAPE_SQUARE: return a * a;
     case TAPE_SQRT: return sqrt(a);
-    case TAPE_EXP: return exp(a);
+    case TAPE_EXP: return exp_kernel(a); /* as the point evaluators */
     case TAPE_LOG: return log(a);
     case TAPE_ABS: return fabs(a);
     case TAPE_SIN: return sin(a);

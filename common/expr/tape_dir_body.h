@@ -38,7 +38,7 @@ static inline double FN(const tape *t, const double p[3], const double seed[3][N
             continue;
         }
         OP(EXP): {
-            const double v = exp(OA.v);
+            const double v = exp_kernel(OA.v);
             TANGENTS r->d[j] = OA.d[j] * v;
             r->v = v;
             continue;

@@ -5,6 +5,7 @@
 
 #include <math.h>
 
+#include "common/expr/exp_kernel.h"
 #include "common/expr/tape_int.h"
 
 #define A s[in[i].a]
@@ -23,7 +24,7 @@ double tape_eval(const tape *t, double x, double y, double z, double *s)
         case TAPE_NEG: s[i] = -A; break;
         case TAPE_SQUARE: s[i] = A * A; break;
         case TAPE_SQRT: s[i] = sqrt(A); break;
-        case TAPE_EXP: s[i] = exp(A); break;
+        case TAPE_EXP: s[i] = exp_kernel(A); break;
         case TAPE_LOG: s[i] = log(A); break;
         case TAPE_ABS: s[i] = fabs(A); break;
         case TAPE_SIN: s[i] = sin(A); break;
@@ -72,7 +73,7 @@ double tape_eval_grad(const tape *t, const double p[3], double grad[3], tape_dua
         case TAPE_NEG: dscale(r, a, -a->v, -1.0); break;
         case TAPE_SQUARE: dscale(r, a, a->v * a->v, 2.0 * a->v); break;
         case TAPE_SQRT: { double v = sqrt(a->v); dscale(r, a, v, 0.5 / v); break; }
-        case TAPE_EXP: { double v = exp(a->v); dscale(r, a, v, v); break; }
+        case TAPE_EXP: { double v = exp_kernel(a->v); dscale(r, a, v, v); break; }
         case TAPE_LOG: dscale(r, a, log(a->v), 1.0 / a->v); break;
         case TAPE_ABS: dscale(r, a, fabs(a->v), a->v < 0.0 ? -1.0 : 1.0); break;
         case TAPE_SIN: { double sv, cv; point_sincos(a->v, &sv, &cv); dscale(r, a, sv, cv); break; }

@@ -4,6 +4,7 @@
  * tape_eval_interval_grad with one tangent (four) instead of three. */
 #include "common/expr/tape_dir.h"
 
+#include "common/expr/exp_kernel.h"
 #include "common/expr/tape_int.h"
 
 #define N 1

@@ -19,6 +19,7 @@
  * (coordinates, direction, constants) are checked where they enter. */
 #include "common/expr/tape_err.h"
 
+#include "common/expr/exp_kernel.h"
 #include "common/expr/tape_int.h"
 
 #define U 0x1p-53   /* + - * / sqrt: half an ulp, at most u of the result */
@@ -108,7 +109,7 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             /* |exp(â) - exp(a)| <= exp(â) (e^ea - 1) <= exp(â) ea (1 + ea) */
             if (!(OA->ev <= 0.0625 && OA->v <= 69.0)) /* (e^69 < BIG: no overflow) */
                 return 0;
-            r->v = exp(OA->v);
+            r->v = exp_kernel(OA->v);
             r->ev = fin(LIB * r->v + r->v * (1.0 + LIB) * OA->ev * (1.0 + OA->ev));
             scaled(r, OA, r->v, r->ev);
             break;

@@ -4,7 +4,7 @@
  * its name.
  *
  * Each lane gives, bit for bit, what tape_eval_interval_grad gives on its
- * box. + - * square neg and exp (its libm call lane by lane) run a fast
+ * box. + - * square neg and exp (il_exp_ends) run a fast
  * path over all lanes: the scalar operations' results where their own fast
  * paths apply (finite operands, normal results, exact zero sums and zero
  * factors), tested on the bit patterns as in tape_ilanes_body.h. A lane
@@ -166,12 +166,16 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
         }
         case TAPE_EXP: {
             tape_ilanes v;
-            for (unsigned l = 0; l < n; l++)
-                il_set(&v, l, interval_exp(il_get(&a->v, l), &fl[l]));
-            for (unsigned l = n; l < W; l++) {
-                v.lo[l] = v.lo[0];
-                v.hi[l] = v.hi[0];
+            uint64_t ok = ~(uint64_t)0, bad[W];
+            LANES {
+                uint64_t e = il_exp_ends(a->v.lo[l], a->v.hi[l], &v.lo[l], &v.hi[l]);
+                bad[l] = e ^ 1;
+                ok &= e;
             }
+            if (!ok)
+                LANES
+                    if (bad[l])
+                        il_set(&v, l, interval_exp(il_get(&a->v, l), &fl[l]));
             for (int j = 0; j < 3; j++)
                 PROD_FN(&r->d[j], &a->d[j], &v, g);
             r->v = v;

@@ -3,7 +3,7 @@
  * compiled for AVX2) once per lane count W (4 or 8), with FN its name.
  *
  * Each lane gives, bit for bit, what tape_eval_interval gives on its box.
- * The cheap operations (+ - * square abs min max neg) run a fast path over
+ * The cheap operations (+ - * square abs min max neg) and exp run a fast path over
  * all lanes at once: the result of the scalar operation's own fast path,
  * taken where that path applies (finite operands, results normal numbers),
  * with the tests made on the bit patterns (integer tests raise no
@@ -20,6 +20,7 @@
 #define SQR_FN CAT(FN, _sqr)
 #define ABS_FN CAT(FN, _abs)
 #define MINMAX_FN CAT(FN, _minmax)
+#define EXP_FN CAT(FN, _exp)
 #define LIBM_FN CAT(FN, _libm)
 #define TRIG_FN CAT(FN, _trig)
 #define TRIG_MEMO_T CAT(FN, _trig_memo)
@@ -130,6 +131,22 @@ static void MINMAX_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a,
         if (bad[l])
             il_set(r, l, is_min ? interval_min(il_get(a, l), il_get(c, l))
                                 : interval_max(il_get(a, l), il_get(c, l)));
+}
+
+/* exp(a), as interval_exp. */
+static void EXP_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, unsigned *fl)
+{
+    uint64_t ok = ~(uint64_t)0, bad[W];
+    LANES {
+        uint64_t g = il_exp_ends(a->lo[l], a->hi[l], &r->lo[l], &r->hi[l]);
+        bad[l] = g ^ 1;
+        ok &= g;
+    }
+    if (ok)
+        return;
+    LANES
+        if (bad[l])
+            il_set(r, l, interval_exp(il_get(a, l), &fl[l]));
 }
 
 /* The operations of interval.c, one lane at a time on lanes 0..n-1; the
@@ -256,6 +273,7 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
             break;
         case TAPE_SQUARE: SQR_FN(r, A, fl); break;
         case TAPE_ABS: ABS_FN(r, A); break;
+        case TAPE_EXP: EXP_FN(r, A, fl); break;
         case TAPE_ADD: ADD_FN(r, A, C, 0, fl); break;
         case TAPE_SUB: ADD_FN(r, A, C, 1, fl); break;
         case TAPE_MUL: MUL_FN(r, A, C, fl); break;
@@ -279,6 +297,7 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
 #undef SQR_FN
 #undef ABS_FN
 #undef MINMAX_FN
+#undef EXP_FN
 #undef LIBM_FN
 #undef TRIG_FN
 #undef TRIG_MEMO_T

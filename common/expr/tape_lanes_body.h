@@ -73,9 +73,7 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
             SCALE(r, A, m);
             break;
         case TAPE_EXP:
-            for (unsigned l = 0; l < n; l++)
-                r->v[l] = exp(A->v[l]);
-            fill(r->v, n);
+            LANES r->v[l] = exp_kernel(A->v[l]); /* lanes from n on: lane 0's */
             SCALE(r, A, r->v);
             break;
         case TAPE_LOG:

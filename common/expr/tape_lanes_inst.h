@@ -6,6 +6,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "common/expr/exp_kernel.h"
 #include "common/expr/tape_int.h"
 
 #define L TAPE_LANES
