@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "common/expr/scene.h"
+#include "common/expr/sincos_kernel.h"
 #include "common/expr/tape.h"
 #include "tests/test_tape_util.h"
 #include "tests/scene_util.h"
@@ -484,15 +485,17 @@ static void test_lanes_shared_arguments(void **state)
     }
 }
 
-/* The gradient evaluators take sin and cos of one argument together
- * (sincos): the value and the derivative must keep the bits of sin and cos
- * called apart, as tape_eval computes them, over many magnitudes. */
+/* Every point evaluator takes sin and cos of one argument together
+ * (sincos_point: the kernel up to SINCOS_KERNEL_MAX, libm beyond): the
+ * gradient evaluators' value and derivative, in lanes and not, and
+ * tape_eval's value keep its bits, over many magnitudes (both sides of the
+ * kernel's range). */
 static void test_trig_gradient_bits(void **state)
 {
     (void)state;
     static const char *texts[2] = {"bounds -1 -1 -1 1 1 1\nsurface sin(x)\n",
                                    "bounds -1 -1 -1 1 1 1\nsurface cos(x)\n"};
-    static const double scales[] = {1e-300, 1e-8, 1.0, 3.0, 1e2, 1e6, 1e15, 1e300};
+    static const double scales[] = {1e-300, 1e-8, 1.0, 3.0, 1e2, 1e5, 0x1p17, 1e6, 1e15, 1e300};
     uint64_t st = 0x9e3779b97f4a7c15ULL;
     for (int k = 0; k < 2; k++) {
         scene *s = NULL;
@@ -500,6 +503,7 @@ static void test_trig_gradient_bits(void **state)
         assert_int_equal(scene_parse(texts[k], strlen(texts[k]), &s, &e), 0);
         const tape *t = &s->surfaces[0].tape;
         tape_dual duals[8];
+        double values[8];
         static tape_dual_lanes lslots[8];
         for (size_t j = 0; j < sizeof scales / sizeof *scales; j++)
             for (int i = 0; i < 20000 / SCALE; i++) {
@@ -512,11 +516,14 @@ static void test_trig_gradient_bits(void **state)
                 for (unsigned l = 0; l < TAPE_LANES; l++) {
                     double p[3] = {x[l], 0.0, 0.0}, g1[3];
                     double f1 = tape_eval_grad(t, p, g1, duals);
-                    double v = k ? cos(x[l]) : sin(x[l]), d = k ? -sin(x[l]) : cos(x[l]);
+                    double f0 = tape_eval(t, x[l], 0.0, 0.0, values);
+                    double sv, cv;
+                    sincos_point(x[l], &sv, &cv);
+                    double v = k ? cv : sv, d = k ? -sv : cv;
                     if (!same_bits(f1, v) || !same_bits(g1[0], d) || !same_bits(f[l], v) ||
-                        !same_bits(g[0][l], d))
-                        fail_msg("%s at %a: %a %a, lanes %a %a, libm %a %a", texts[k], x[l], f1,
-                                 g1[0], f[l], g[0][l], v, d);
+                        !same_bits(g[0][l], d) || !same_bits(f0, v))
+                        fail_msg("%s at %a: %a %a, lanes %a %a, value %a, sincos_point %a %a",
+                                 texts[k], x[l], f1, g1[0], f[l], g[0][l], f0, v, d);
                 }
             }
         scene_free(s);

@@ -3,6 +3,7 @@
 #include "common/expr/interval.h"
 
 #include "common/expr/exp_kernel.h"
+#include "common/expr/sincos_kernel.h"
 
 #include <float.h>
 #include <math.h>
@@ -169,7 +170,8 @@ interval interval_cos(interval a, unsigned *flags) { return sin_or_cos(a, flags,
  * sin x = sin m + cos m (x - m) - sin(xi) (x - m)^2 / 2 for some xi between
  * m and x, and |sin xi - sin m| <= |xi - m| <= h; likewise cos x = cos m -
  * sin m (x - m) - cos(xi) (x - m)^2 / 2. sin m and cos m come from one
- * sincos (the bits of sin and cos), within 2 ulps (2^-52) of the reals,
+ * sincos_point (sincos_kernel.h; libm beyond its range), within 2 ulps
+ * (2^-52) of the reals,
  * the assumption interval_sin makes too. h is max |x - m| raised by 2^-50
  * of itself (above its rounding). Every term of the sums is at most 1.125
  * in magnitude and there are five roundings, each within 2^-53: with the
@@ -186,12 +188,7 @@ void interval_sincos(interval a, interval *so, interval *co, unsigned *flags)
         return;
     }
     double m = interval__sincos_mid(a), sm, cm;
-#if defined(__GLIBC__)
-    sincos(m, &sm, &cm);
-#else
-    sm = sin(m);
-    cm = cos(m);
-#endif
+    sincos_point(m, &sm, &cm);
     double h = interval__sincos_half(a, m), q = 0.5 * h * h;
     if (so)
         *so = interval__sincos_form(sm, cm, h, q);

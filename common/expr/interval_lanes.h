@@ -57,13 +57,16 @@ static inline interval il_add(interval a, interval b, uint64_t *ok)
  * 2^-1021 and the upper below 2^1023; the result is then their two bit steps
  * outward (dn2_pos, up2_pos), returned with 1, else 0 (*rl, *rh are then not
  * interval_exp's; a NaN end fails the test). */
-static inline __attribute__((always_inline)) uint64_t il_exp_ends(double lo, double hi, double *rl, double *rh)
+static inline __attribute__((always_inline)) uint64_t il_exp_ends(double lo, double hi,
+                                                                  double *rl, double *rh)
 {
     const uint64_t el = double_bits(exp_kernel(lo)), eh = double_bits(exp_kernel(hi));
     const uint64_t min_lo = double_bits(0x1p-1021), min_hi = double_bits(0x1p-1022);
     *rl = bits_double(el - 2);
     *rh = bits_double(eh + 2);
-    return (el - min_lo < double_bits(INFINITY) - min_lo) & (eh - min_hi < double_bits(0x1p1023) - min_hi);
+    /* positive doubles order as their bits; NaN's bits lie above +inf's */
+    return (el - min_lo < double_bits(INFINITY) - min_lo) &
+           (eh - min_hi < double_bits(0x1p1023) - min_hi);
 }
 
 /* 1 when x is +0 or -0. */

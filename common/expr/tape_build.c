@@ -209,8 +209,8 @@ static double point_op(tape_op op, double a, double c, double p)
     case TAPE_EXP: return exp_kernel(a); /* as the point evaluators */
     case TAPE_LOG: return log(a);
     case TAPE_ABS: return fabs(a);
-    case TAPE_SIN: return sin(a);
-    case TAPE_COS: return cos(a);
+    case TAPE_SIN: { double s, co; point_sincos(a, &s, &co); return s; } /* as the evaluators */
+    case TAPE_COS: { double s, co; point_sincos(a, &s, &co); return co; }
     case TAPE_TAN: return tan(a);
     case TAPE_ADD: return a + c;
     case TAPE_SUB: return a - c;

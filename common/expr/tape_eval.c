@@ -27,8 +27,8 @@ double tape_eval(const tape *t, double x, double y, double z, double *s)
         case TAPE_EXP: s[i] = exp_kernel(A); break;
         case TAPE_LOG: s[i] = log(A); break;
         case TAPE_ABS: s[i] = fabs(A); break;
-        case TAPE_SIN: s[i] = sin(A); break;
-        case TAPE_COS: s[i] = cos(A); break;
+        case TAPE_SIN: { double c; point_sincos(A, &s[i], &c); break; }
+        case TAPE_COS: { double sv; point_sincos(A, &sv, &s[i]); break; }
         case TAPE_TAN: s[i] = tan(A); break;
         case TAPE_ADD: s[i] = A + C; break;
         case TAPE_SUB: s[i] = A - C; break;

@@ -191,7 +191,7 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
          * sincos each, then their forms side by side; a lane whose
          * argument has an earlier lane's bits (a cell's children share
          * each coordinate in halves) takes that lane's results and flags. */
-        double mid[W], sm[W], cm[W];
+        double mid[W] = {0}, sm[W], cm[W];
         unsigned narrow = 0, same[W], lf[W];
         for (unsigned l = 0; l < n; l++) {
             same[l] = il_first_same(a, l);
@@ -210,9 +210,8 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
                 il_set(&m->c[j], l, cv);
             }
         }
-        for (unsigned l = 0; l < n; l++)
-            if (narrow >> l & 1)
-                point_sincos(mid[l], &sm[l], &cm[l]);
+        if (narrow)
+            sincos_point_lanes(W, W, mid, sm, cm); /* every lane: vector code */
         for (unsigned l = 0; l < n; l++)
             if (narrow >> l & 1) {
                 interval x = il_get(a, l);

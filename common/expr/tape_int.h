@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "common/expr/sincos_kernel.h"
 #include "common/expr/tape.h"
 
 /* min and max in double that propagate NaN from either operand. The
@@ -15,52 +16,9 @@
 static inline double point_min(double a, double b) { return (a < b || a != a) ? a : b; }
 static inline double point_max(double a, double b) { return (a > b || a != a) ? a : b; }
 
-/* sin(x) and cos(x) for the gradient evaluators, which want both: glibc's
- * sincos shares the argument reduction and returns the same bits as sin and
- * cos called apart (tests/test_tape.c checks it); elsewhere, the two calls. */
-static inline void point_sincos(double x, double *s, double *c)
-{
-#if defined(__GLIBC__)
-    sincos(x, s, c);
-#else
-    *s = sin(x);
-    *c = cos(x);
-#endif
-}
-
-/* The first of lanes x[0..l] with the bits of x[l] (l itself when no
- * earlier one has them). Bits, not ==: -0 and +0 have sines of opposite
- * signs. */
-static inline unsigned lane_first_same(const double *x, unsigned l)
-{
-    uint64_t b;
-    memcpy(&b, &x[l], sizeof b);
-    for (unsigned j = 0; j < l; j++) {
-        uint64_t bj;
-        memcpy(&bj, &x[j], sizeof bj);
-        if (bj == b)
-            return j;
-    }
-    return l;
-}
-
-/* point_sincos of x[0..n-1], one call per distinct argument: a lane whose
- * argument has an earlier lane's bits takes that lane's results (the same
- * call on the same bits gives the same bits). A cell's children share each
- * coordinate in halves, so sin(3 pi x) at a leaf-parent's eight voxel
- * centres takes two calls, not eight. */
-static inline void point_sincos_lanes(const double *x, unsigned n, double *s, double *c)
-{
-    for (unsigned l = 0; l < n; l++) {
-        const unsigned j = lane_first_same(x, l);
-        if (j < l) {
-            s[l] = s[j];
-            c[l] = c[j];
-        } else {
-            point_sincos(x[l], &s[l], &c[l]);
-        }
-    }
-}
+/* sin(x) and cos(x) for every point evaluator (sincos_kernel.h: one
+ * reduction for both). */
+static inline void point_sincos(double x, double *s, double *c) { sincos_point(x, s, c); }
 
 /* The sin and cos of the last TRIG_MEMO argument slots of a trigonometric
  * instruction in one evaluation (slots are written once), so that the sin
@@ -120,15 +78,15 @@ typedef struct trig_memo_lanes {
 
 static inline void trig_memo_lanes_init(trig_memo_lanes *m) { trig_memo_keys_init(&m->k); }
 
-/* The memo's entry for argument slot a (values x[0..n-1]), made on a miss;
- * lanes n.. of the entry are left as they are (the callers fill them). */
+/* The memo's entry for argument slot a (values x[0..n-1]), made on a miss,
+ * every lane at once (vector code); lanes n.. of the entry take lane 0's. */
 static inline unsigned trig_memo_lanes_entry(trig_memo_lanes *m, uint32_t a, const double *x,
                                              unsigned n)
 {
     int miss;
     const unsigned j = trig_memo_find(&m->k, a, &miss);
     if (miss)
-        point_sincos_lanes(x, n, m->s[j], m->c[j]);
+        sincos_point_lanes(TAPE_LANES, n, x, m->s[j], m->c[j]);
     return j;
 }
 

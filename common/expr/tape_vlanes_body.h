@@ -49,7 +49,7 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
         case TAPE_ABS: LANES r->v[l] = fabs(A[l]); break;
         case TAPE_SIN:
         case TAPE_COS: {
-            /* sincos's bits are sin's and cos's (point_sincos) */
+            /* sin and cos from one point_sincos, in lanes */
             const unsigned j = trig_memo_lanes_entry(&tm, in[i].a, A, n);
             memcpy(r->v, op == TAPE_SIN ? tm.s[j] : tm.c[j], n * sizeof r->v[0]);
             fill(r->v, n);
