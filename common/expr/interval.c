@@ -2,12 +2,12 @@
  * rounding and flag rules). */
 #include "common/expr/interval.h"
 
-#include "common/expr/exp_kernel.h"
-#include "common/expr/sincos_kernel.h"
-
 #include <float.h>
 #include <math.h>
 #include <string.h>
+
+#include "common/expr/exp_kernel.h"
+#include "common/expr/sincos_kernel.h"
 
 /* Short local names for the helpers of interval.h. */
 static inline double up(double x) { return interval_next_up(x); }

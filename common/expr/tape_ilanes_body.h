@@ -187,8 +187,8 @@ static void TRIG_FN(tape_ilanes *restrict r, const tape_ilanes *restrict a, uint
     int miss;
     const unsigned j = trig_memo_find(&m->k, slot, &miss);
     if (miss) {
-        /* interval_sincos in lanes: the narrow lanes' midpoints, one
-         * sincos each, then their forms side by side; a lane whose
+        /* interval_sincos in lanes: the narrow lanes' midpoints' sin and
+         * cos (all lanes at once), then their forms; a lane whose
          * argument has an earlier lane's bits (a cell's children share
          * each coordinate in halves) takes that lane's results and flags. */
         double mid[W] = {0}, sm[W], cm[W];
