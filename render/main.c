@@ -69,7 +69,7 @@ static const char help_text[] =
     "  --shadows           one shadow ray per lit hit towards --light\n"
     "  --ao N              ambient occlusion: N rays over each hit's hemisphere,\n"
     "                      0.." LIMIT_STR(VIEWS_AO_MAX) " (default 0: off)\n"
-    "  --ao-distance F     the AO rays' length in cube edges, (0, " LIMIT_STR(VIEWS_AO_DISTANCE_MAX) "] (default 0.125)\n"
+    "  --ao-distance F     the AO rays' length in cube edges, (0, " LIMIT_STR(VIEWS_AO_DISTANCE_MAX) "] (default " LIMIT_STR(VIEWS_AO_DISTANCE) ")\n"
     "  --light X,Y,Z       direction towards the light (default over the viewer's shoulder)\n"
     "  --background R,G,B  linear colour of rays that miss, 0..1 each (default 0,0,0)\n"
     "  --threads N         worker threads, 1.." LIMIT_STR(THREADS_MAX) " (default: online CPUs, at most "

@@ -4,10 +4,10 @@
  * its name.
  *
  * Each lane gives, bit for bit, what tape_eval_interval_grad gives on its
- * box. + - * square neg and exp (il_exp_ends) run a fast
- * path over all lanes: the scalar operations' results where their own fast
- * paths apply (finite operands, normal results, exact zero sums and zero
- * factors), tested on the bit patterns as in tape_ilanes_body.h. A lane
+ * box. + - * square neg and exp (il_exp_ends) run a fast path over all
+ * lanes: the scalar operations' results where their own fast paths apply
+ * (finite operands, normal results, exact zero sums and zero factors),
+ * tested on the bit patterns as in tape_ilanes_body.h. A lane
  * where one does not apply is redone by the scalar instruction
  * (tape_idual_op.h), as are all the other operations, lane by lane on
  * lanes 0..n-1. Lanes n..W-1 repeat lane 0. */
