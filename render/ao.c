@@ -4,6 +4,7 @@
 #include <math.h>
 #include <pthread.h>
 
+#include "render/ao_grid.h"
 #include "render/basis.h"
 #include "render/shadow.h"
 
@@ -62,12 +63,25 @@ void ao_direction(const float n[3], unsigned k, unsigned m, uint32_t seed, doubl
     ao_direction_in(&f, k, m, d);
 }
 
+int ao_grid_wanted(const trace_opts *opts, trace_traverse_fn traverse)
+{
+#if TRACE_HAVE_SSE
+    /* the grid's walk is the SSE any-hit walk's, with the empty space
+       between the occupied cells crossed by the grid */
+    return shadow_any_hit(opts, traverse) == trace_occluded_sse;
+#else
+    (void)opts;
+    (void)traverse;
+    return 0;
+#endif
+}
+
 /* The unoccluded fraction of the rays k0 .. k0 + count - 1 from the grid
  * position e, started at anchor an, each reach cube edges long. */
 static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                            const trace_eye *e, const trace_anchor *an, const float n[3],
                            unsigned k0, unsigned count, unsigned m, uint32_t seed, double reach,
-                           uint64_t *steps)
+                           const ao_grid *grid, uint64_t *steps)
 {
     const double dist = reach * tree->edge;
     ao_frame f;
@@ -75,6 +89,8 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
     unsigned open = 0;
     /* shadow_cast's choice, made once for the hit's rays */
     const trace_occluded_fn occluded = shadow_any_hit(opts, traverse);
+    if (!ao_grid_wanted(opts, traverse))
+        grid = NULL;
     for (unsigned k = k0; k < k0 + count; k++) {
         double d[3];
         ao_direction_in(&f, k, m, d);
@@ -85,7 +101,12 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
         }
         if (occluded) {
             uint32_t ray_steps;
-            open += !occluded(tree, &r, an, &ray_steps);
+#if TRACE_HAVE_SSE
+            if (grid)
+                open += !trace_occluded_grid_sse(tree, grid, &r, an, &ray_steps);
+            else
+#endif
+                open += !occluded(tree, &r, an, &ray_steps);
             *steps += ray_steps;
         } else {
             open += !shadow_cast(tree, opts, traverse, &r, an, steps);
@@ -114,15 +135,16 @@ float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn 
         }
         trace_anchor_find(tree, lo, hi, &an);
     }
-    return open_fraction(tree, opts, traverse, &e, &an, n, k0, count, m, seed, reach, steps);
+    return open_fraction(tree, opts, traverse, &e, &an, n, k0, count, m, seed, reach, NULL, steps);
 }
 
 float ao_factor_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                      const shadow_start *s, const float n[3], unsigned k0, unsigned count,
-                     unsigned m, uint32_t seed, double reach, uint64_t *steps)
+                     unsigned m, uint32_t seed, double reach, const ao_grid *grid,
+                     uint64_t *steps)
 {
     if (!s->eye.ok)
         return 1.0f;
     return open_fraction(tree, opts, traverse, &s->eye, &s->anchor, n, k0, count, m, seed, reach,
-                         steps);
+                         grid, steps);
 }

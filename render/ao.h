@@ -47,12 +47,21 @@ float ao_factor(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn 
                 const double o[3], const float n[3], unsigned k0, unsigned count, unsigned m,
                 uint32_t seed, double reach, uint64_t *steps);
 
+/* 1 when AO rays under opts and traverse walk through the clearance grid
+ * (render/ao_grid.h) if one is given: the paper's rule and the SSE any-hit
+ * walk. */
+int ao_grid_wanted(const trace_opts *opts, trace_traverse_fn traverse);
+
 struct shadow_start; /* render/shadow.h */
+struct ao_grid;      /* render/ao_grid.h */
 
 /* ao_factor from a hit's shared start (shadow_start_hit's), its rays
- * started at its anchor: the same factor and steps. */
+ * started at its anchor, or (grid not NULL, the SSE any-hit walk in use)
+ * walked through the tree's clearance grid: the same factor (the steps
+ * differ with a grid). */
 float ao_factor_from(const oct_tree *tree, const trace_opts *opts, trace_traverse_fn traverse,
                      const struct shadow_start *s, const float n[3], unsigned k0, unsigned count,
-                     unsigned m, uint32_t seed, double reach, uint64_t *steps);
+                     unsigned m, uint32_t seed, double reach, const struct ao_grid *grid,
+                     uint64_t *steps);
 
 #endif

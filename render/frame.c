@@ -16,6 +16,7 @@
 
 #include "common/test_hooks.h"
 #include "common/view/image.h"
+#include "render/ao.h"
 #include "render/beam.h"
 #include "render/map_guard.h"
 #include "render/shadow.h"
@@ -445,6 +446,8 @@ static void border_free(frame_keep *k)
 void frame_keep_free(frame_keep *k)
 {
     shadow_map_cache_free(&k->maps);
+    ao_grid_free(&k->grid);
+    k->grid_tree = NULL;
     border_free(k);
 }
 
@@ -502,6 +505,20 @@ int frame_render(const frame_job *job, frame_stats *stats)
                               job->threads, &built);
         if (job->timing && built)
             sy.shadow_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
+    }
+    if (job->shade.ao_rays && ao_grid_wanted(&job->opts, sh.traverse)) {
+        /* made once for the tree (a failure leaves the plain walk); its
+           time is the AO rays' */
+        if (keep->grid_tree != job->tree) {
+            const double t0 = job->timing ? frame_now_ns() : 0.0;
+            ao_grid_free(&keep->grid);
+            keep->grid_tree = job->tree;
+            ao_grid_build(job->tree, &keep->grid);
+            if (job->timing)
+                sy.ao_ns += (frame_now_ns() - t0) * (job->threads > 1 ? job->threads : 1);
+        }
+        if (keep->grid.n)
+            sh.ao_grid = &keep->grid;
     }
     if (job->aa > 1) {
         if (keep_border(keep, ntiles) == 0) {

@@ -10,6 +10,7 @@
 #include "common/view/camera.h"
 #include "format/oct.h"
 #include "render/aa.h"
+#include "render/ao_grid.h"
 #include "render/exact_scene.h"
 #include "render/shade.h"
 #include "render/shadow_map.h"
@@ -62,6 +63,8 @@ typedef struct frame_job {
  * the end. */
 typedef struct frame_keep {
     shadow_map_cache maps;
+    ao_grid grid;          /* with --ao: grid_tree's clearance grid (n = 0: none) */
+    const oct_tree *grid_tree; /* the tree the grid was made for, or NULL */
     aa_probe *border;      /* border_tiles tiles' probes, or NULL */
     uint8_t *border_hit;   /* a byte a tile */
     size_t border_tiles;

@@ -42,6 +42,7 @@ typedef struct frame_shared {
     aa_probe *border; /* with tile: FRAME_BORDER probes a tile, tiles in row order */
     uint8_t *border_hit; /* with border: per tile, bit s when a probe of side s hit */
     const shadow_map *shadow_map; /* with --shadows: the light's map, or NULL */
+    const struct ao_grid *ao_grid; /* with --ao: the tree's clearance grid, or NULL */
     int phase;        /* 0: centre rays, then the samples a tile's own pixels
                          ask for; 1: those the pairs across tiles ask for */
     uint32_t tiles_x, tiles_y;

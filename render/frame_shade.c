@@ -52,7 +52,7 @@ void frame_shade_sample(const frame_shared *sh, frame_acc *acc, const trace_hit 
         }
         if (ao_count) {
             ao = ao_factor_from(job->tree, &job->opts, sh->traverse, st, n, ao_k0, ao_count,
-                                ao_total, ao_seed(i, j), job->shade.ao_distance,
+                                ao_total, ao_seed(i, j), job->shade.ao_distance, sh->ao_grid,
                                 &acc->secondary_steps);
             acc->ao_rays += ao_count;
         }

@@ -58,6 +58,9 @@ int trace_occluded_portable(const oct_tree *tree, const trace_ray *r, const trac
 #if TRACE_HAVE_SSE
 int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
                        uint32_t *steps);
+struct ao_grid;
+int trace_occluded_grid_sse(const oct_tree *tree, const struct ao_grid *g, const trace_ray *r,
+                            const trace_anchor *anchor, uint32_t *steps);
 #endif
 
 /* The children a ray visits in a cell, from the order of its mid-plane

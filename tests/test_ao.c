@@ -261,7 +261,7 @@ static void test_shared_start_same_answers(void **state)
                     uint64_t s0 = 0, s1 = 0;
                     const float f0 = ao_factor(t, &o, fn, org, n, 0, 16, 16, seed, REACH, &s0);
                     const float f1 =
-                        ao_factor_from(t, &o, fn, &st, n, 0, 16, 16, seed, REACH, &s1);
+                        ao_factor_from(t, &o, fn, &st, n, 0, 16, 16, seed, REACH, NULL, &s1);
                     assert_true(f0 == f1);
                     assert_true(s0 == s1);
                     shaded += f0 < 1.0f;
