@@ -72,6 +72,8 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
     __m128d TC = _mm_set1_pd(r->t_start);
     trace_frame fr[OCT_MAX_LEVELS];
     __m128i C;
+    __m128d TEv;    /* a step out of the current cell: its time, */
+    unsigned exits; /* and the axes it crosses */
     int hit = 0;
     if (anchor && anchor->depth > depth) {
         /* the start lies in the anchor's cell, in an occupied cell of the
@@ -88,18 +90,15 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
         __m128d Txy, Tzw, TPxy, TPzw;
         trace_cell_exits(V, size, &ax, &Txy, &Tzw);
         trace_cell_exits(V, 2u * size, &ax, &TPxy, &TPzw);
-        if (occluded_walk(groups, &ax, levels, depth, fr, d, fr[d].ci, size, V, Txy, Tzw, TPxy,
-                          TPzw, TC, fr[d - 1].mask, fr[d - 1].prefix, fr[d].mask, fr[d].prefix,
-                          t_end, &left)) {
+        const int res = occluded_walk(groups, &ax, levels, depth, fr, d, fr[d].ci, size, V, Txy,
+                                      Tzw, TPxy, TPzw, TC, fr[d - 1].mask, fr[d - 1].prefix,
+                                      fr[d].mask, fr[d].prefix, t_end, &left, &TEv, &exits);
+        if (res != WALK_LEFT) {
             *steps_out = max_steps - left;
-            return 1;
-        }
-        if (left == UINT32_MAX) {
-            *steps_out = max_steps - left;
-            return 0;
+            return res == WALK_HIT;
         }
         C = _mm_srl_epi32(V, SH);
-        goto leave_cell;
+        goto next_cell;
     } else {
         uint32_t c[4];
         for (int a = 0; a < 3; a++)
@@ -118,33 +117,25 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
             __m128d Txy, Tzw;
             trace_cell_exits(V, cs, &ax, &Txy, &Tzw);
             const oct_children ch = oct_node_children(groups[depth], AO_GRID_NODE(w));
-            if (occluded_walk(groups, &ax, levels, depth, fr, depth, 0, cs, V, Txy, Tzw, Txy, Tzw,
-                              TC, 0, 0, ch.mask, ch.first, t_end, &left)) {
-                hit = 1;
+            const int res = occluded_walk(groups, &ax, levels, depth, fr, depth, 0, cs, V, Txy, Tzw,
+                                          Txy, Tzw, TC, 0, 0, ch.mask, ch.first, t_end, &left,
+                                          &TEv, &exits);
+            if (res != WALK_LEFT) {
+                hit = res == WALK_HIT;
                 break;
             }
-            if (left == UINT32_MAX)
-                break;
+            goto next_cell;
         }
-        if (k <= 1) {
-            /* one cell: left through its exit planes into the next cell
-               on those axes, the same cell on the others */
-        leave_cell:;
+        if (k == 1) {
+            /* the cell alone: left through its exit planes */
             __m128d Txy, Tzw;
-            grid_plane_times(_mm_sll_epi32(_mm_sub_epi32(C, ax.FARM), SH), &ax,
-                             &Txy, &Tzw);
+            grid_plane_times(_mm_sll_epi32(_mm_sub_epi32(C, ax.FARM), SH), &ax, &Txy, &Tzw);
             const __m128d m2 = _mm_min_pd(Txy, Tzw);
-            const __m128d TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
+            TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
             if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
                 break;
-            const unsigned exits = grid_mask(_mm_cmpeq_pd(Txy, TEv), _mm_cmpeq_pd(Tzw, TEv));
-            const __m128i EM = _mm_load_si128((const __m128i *)trace_lut[exits]);
-            C = _mm_add_epi32(C, _mm_and_si128(EM, DIR));
-            const __m128i OUTS = _mm_or_si128(_mm_cmpgt_epi32(ZERO, C), _mm_cmpeq_epi32(C, NMAX));
-            if (!_mm_testz_si128(OUTS, OUTS))
-                break; /* the root left */
-            TC = TEv;
-            continue;
+            exits = grid_mask(_mm_cmpeq_pd(Txy, TEv), _mm_cmpeq_pd(Tzw, TEv));
+            goto next_cell;
         }
         /* the empty cube of k cells from C on the ray's side */
         const __m128i K1 = _mm_set1_epi32((int32_t)k - 1);
@@ -155,10 +146,10 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
         __m128d Txy, Tzw;
         grid_plane_times(_mm_sll_epi32(_mm_blendv_epi8(LO, HI, ax.FARM), SH), &ax, &Txy, &Tzw);
         const __m128d m2 = _mm_min_pd(Txy, Tzw);
-        const __m128d TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
+        TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
         if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
             break;
-        const unsigned exits = grid_mask(_mm_cmpeq_pd(Txy, TEv), _mm_cmpeq_pd(Tzw, TEv));
+        exits = grid_mask(_mm_cmpeq_pd(Txy, TEv), _mm_cmpeq_pd(Tzw, TEv));
         /* past the box on the exit axes; the root is left past 0 or n */
         const __m128i NEXT = _mm_blendv_epi8(_mm_sub_epi32(LO, ONE), HI, ax.FARM);
         const __m128i EM = _mm_load_si128((const __m128i *)trace_lut[exits]);
@@ -193,6 +184,15 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
                     cc[a] = grid_cell_at(r, a, te, shift, lo[a], hi[a]);
             C = _mm_loadu_si128((const __m128i *)cc);
         }
+        TC = TEv;
+        continue;
+    next_cell:;
+        /* one cell on along the exit axes, the same cell on the others
+           (the step left only the current cell, or its box was one cell) */
+        C = _mm_add_epi32(C, _mm_and_si128(_mm_load_si128((const __m128i *)trace_lut[exits]), DIR));
+        const __m128i OUT = _mm_or_si128(_mm_cmpgt_epi32(ZERO, C), _mm_cmpeq_epi32(C, NMAX));
+        if (!_mm_testz_si128(OUT, OUT))
+            break; /* the root left */
         TC = TEv;
     }
     *steps_out = max_steps - left;

@@ -269,8 +269,11 @@ int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anc
         Pn = P;
     }
     trace_cell_exits(V, size, &ax, &Txy, &Tzw);
+    __m128d exit_t; /* not set: the floor is the root */
+    unsigned exit_mask;
     const int hit = occluded_walk(groups, &ax, levels, 0, fr, d, ci, size, V, Txy, Tzw, TPxy, TPzw,
-                                  _mm_set1_pd(r->t_start), M, P, Mn, Pn, r->t_end, &left);
+                                  _mm_set1_pd(r->t_start), M, P, Mn, Pn, r->t_end, &left, &exit_t,
+                                  &exit_mask) == WALK_HIT;
     *steps_out = max_steps - left; /* max_steps + 1 when the bound was passed */
     return hit;
 }

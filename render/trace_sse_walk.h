@@ -153,25 +153,28 @@ SSE_INLINE int climb(const trace_frame *fr, const sse_axes *ax, unsigned floor, 
 /* The any-hit walk's loop (trace_occluded_sse's), entered with a look at
  * the current cell: depth d, child index ci, corner V, edge size, exit
  * times T, its parent's TP and node (M, P), its own node (Mn, Pn), entered
- * at TC; fr holds the frames above it from depth `floor` + 1 on. Returns 1
- * at an occupied voxel on the way; 0 when the ray passes t_end, uses up
- * *left steps (then *left wraps to UINT32_MAX), or leaves the cell at depth
- * `floor` (0: the root). */
+ * at TC; fr holds the frames above it from depth `floor` + 1 on. Returns
+ * WALK_HIT at an occupied voxel on the way; WALK_LEFT when it leaves the
+ * cell at depth `floor` > 0, at *exit_t (in both lanes) through the axes
+ * *exit_mask (that step counted); WALK_END when the ray passes t_end, uses
+ * up *left steps (then *left wraps to UINT32_MAX) or leaves the root. */
+enum { WALK_END, WALK_HIT, WALK_LEFT };
 SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax, unsigned levels,
                              unsigned floor, trace_frame *fr, unsigned d, unsigned ci,
                              uint32_t size, __m128i V, __m128d Txy, __m128d Tzw, __m128d TPxy,
                              __m128d TPzw, __m128d TC, uint32_t M, uint64_t P, uint32_t Mn,
-                             uint64_t Pn, double t_end, uint32_t *left_io)
+                             uint64_t Pn, double t_end, uint32_t *left_io, __m128d *exit_t,
+                             unsigned *exit_mask)
 {
     const __m128d TEND = _mm_set1_pd(t_end);
     const unsigned far = ax->far;
     uint32_t left = *left_io;
-    int hit = 0;
+    int res = WALK_END;
     goto look;
     for (;;) {
         if (M >> ci & 1u) {
             if (d == levels) {
-                hit = 1; /* entered after a tie above */
+                res = WALK_HIT; /* entered after a tie above */
                 break;
             }
             const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
@@ -202,9 +205,11 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
             const unsigned c0 = near ^ far;
             const unsigned crossed = near & before;
             if (!(trace_path_children[c0 | crossed << 3 | order << 6] & Mn)) {
-                if (d == floor)
-                    break; /* the root, or the walk's own cell */
-                goto step; /* nothing on the way: as an empty cell */
+                if (d != floor)
+                    goto step; /* nothing on the way: as an empty cell */
+                if (!floor)
+                    break; /* the root */
+                goto leave; /* the walk's own cell */
             }
             if (d + 1 == levels) {
                 /* the set is exact unless two crossed mid planes tie */
@@ -212,7 +217,7 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
                     (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))) |
                     ((unsigned)_mm_movemask_pd(_mm_cmpeq_sd(TMxy, TMzw)) & 1u) << 2;
                 if (!(eq & TRACE_PAIRS(crossed))) {
-                    hit = 1; /* a voxel on the way */
+                    res = WALK_HIT; /* a voxel on the way */
                     break;
                 }
             }
@@ -240,17 +245,40 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
         __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
         unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
         if ((~(ci ^ far) & smask) && !climb(fr, ax, floor, TEv, &d, &ci, &size, &V, &smask, &Exy,
-                                             &Ezw, &Txy, &Tzw, &TPxy, &TPzw, &M, &P))
+                                             &Ezw, &Txy, &Tzw, &TPxy, &TPzw, &M, &P)) {
+            /* the floor's cell left: through the stepped axes on which its
+               child (ci) is on the far half; on the others the step only
+               crosses the floor cell's mid plane (and no other axis of the
+               floor cell's exits at TEv: the child's later exits are not
+               nearer on the parent) */
+            if (floor) {
+                *exit_t = TEv;
+                *exit_mask = smask & ~(ci ^ far) & 7u;
+                res = WALK_LEFT;
+            }
             break;
+        }
         ci ^= smask;
         Txy = _mm_blendv_pd(Txy, TPxy, Exy);
         Tzw = _mm_blendv_pd(Tzw, TPzw, Ezw);
         V = _mm_xor_si128(V, _mm_and_si128(_mm_set1_epi32((int32_t)size),
                                            _mm_load_si128((const __m128i *)trace_lut[smask])));
         TC = TEv;
+        continue;
+    leave:;
+        /* nothing on the way in the floor's cell: left through its exits */
+        const __m128d f2 = _mm_min_pd(Txy, Tzw);
+        const __m128d TFv = _mm_min_pd(f2, _mm_shuffle_pd(f2, f2, 1));
+        if (_mm_cvtsd_f64(TFv) >= t_end || left-- == 0)
+            break;
+        *exit_t = TFv;
+        *exit_mask = (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Txy, TFv)) |
+                     (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Tzw, TFv)) << 2;
+        res = WALK_LEFT;
+        break;
     }
     *left_io = left;
-    return hit;
+    return res;
 }
 
 #endif
