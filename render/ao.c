@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <string.h>
 
 #include "render/ao_grid.h"
 #include "render/basis.h"
@@ -11,7 +12,20 @@
 /* cos and sin of 2 pi frac(k phi), k < AO_MAX_RAYS: the pattern's azimuths,
  * made once; a hit turns them by its pixel's angle (ao_basis). */
 static double azimuth[AO_MAX_RAYS][2];
+/* sqrt(u_k) and sqrt(1 - u_k) of ray k of M <= STRATA_TABLED, at
+ * M (M - 1) / 2 + k: made once, off each ray's chain of dependent
+ * operations (a division and two square roots) */
+#define STRATA_TABLED 64u
+static double strata[STRATA_TABLED * (STRATA_TABLED + 1) / 2][2];
 static pthread_once_t azimuth_once = PTHREAD_ONCE_INIT;
+
+/* sqrt(u) and sqrt(1 - u) of ray k of m, u = (k + 1/2) / m */
+static void stratum(unsigned k, unsigned m, double rc[2])
+{
+    const double u = ((double)k + 0.5) / (double)m;
+    rc[0] = sqrt(u);
+    rc[1] = sqrt(1.0 - u);
+}
 
 static void azimuth_init(void)
 {
@@ -21,6 +35,9 @@ static void azimuth_init(void)
         azimuth[k][0] = cos(2.0 * M_PI * turns);
         azimuth[k][1] = sin(2.0 * M_PI * turns);
     }
+    for (unsigned m = 1; m <= STRATA_TABLED; m++)
+        for (unsigned k = 0; k < m; k++)
+            stratum(k, m, strata[m * (m - 1) / 2 + k]);
 }
 
 uint32_t ao_seed(uint32_t i, uint32_t j)
@@ -48,8 +65,12 @@ void ao_basis(const float n[3], uint32_t seed, ao_frame *f)
 
 void ao_direction_in(const ao_frame *f, unsigned k, unsigned m, double d[3])
 {
-    const double u = ((double)k + 0.5) / (double)m;
-    const double r = sqrt(u), c = sqrt(1.0 - u);
+    double rc[2];
+    if (m <= STRATA_TABLED)
+        memcpy(rc, strata[m * (m - 1) / 2 + k], sizeof rc);
+    else
+        stratum(k, m, rc);
+    const double r = rc[0], c = rc[1];
     const double ca = azimuth[k][0], sa = azimuth[k][1]; /* turned by the pixel's angle */
     const double x = r * (ca * f->cs - sa * f->ss), y = r * (sa * f->cs + ca * f->ss);
     for (int a = 0; a < 3; a++)
