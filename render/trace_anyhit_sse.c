@@ -1,12 +1,205 @@
-/* trace_grid_sse: the any-hit walk of AO rays through the clearance grid
- * (render/ao_grid.h), built where the SSE traversal is. */
+/* trace_anyhit_sse: the any-hit walks of secondary rays with the three
+ * axes in SSE registers (trace_impl.h): the plain walk, and the walk of AO
+ * rays through the clearance grid (render/ao_grid.h). Built where the SSE
+ * traversal is. */
 #include "render/ao_grid.h"
 #include "render/trace_impl.h"
 
 #if TRACE_HAVE_SSE
-#include <math.h>
+#include <string.h>
 
 #include "render/trace_sse_walk.h"
+
+/* The any-hit walk's loop (trace_occluded_sse's), entered with a look at
+ * the current cell: depth d, child index ci, corner V, edge size, exit
+ * times T, its parent's TP and node (M, P), its own node (Mn, Pn), entered
+ * at TC; fr holds the frames above it from depth `floor` + 1 on. Returns
+ * WALK_HIT at an occupied voxel on the way; WALK_LEFT when it leaves the
+ * cell at depth `floor` > 0, at *exit_t (in both lanes) through the axes
+ * *exit_mask (that step counted); WALK_END when the ray passes t_end, uses
+ * up *left steps (then *left wraps to UINT32_MAX) or leaves the root. */
+enum { WALK_END, WALK_HIT, WALK_LEFT };
+SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax, unsigned levels,
+                             unsigned floor, trace_frame *fr, unsigned d, unsigned ci,
+                             uint32_t size, __m128i V, __m128d Txy, __m128d Tzw, __m128d TPxy,
+                             __m128d TPzw, __m128d TC, uint32_t M, uint64_t P, uint32_t Mn,
+                             uint64_t Pn, double t_end, uint32_t *left_io, __m128d *exit_t,
+                             unsigned *exit_mask)
+{
+    const __m128d TEND = _mm_set1_pd(t_end);
+    const unsigned far = ax->far;
+    uint32_t left = *left_io;
+    int res = WALK_END;
+    goto look;
+    for (;;) {
+        if (M >> ci & 1u) {
+            if (d == levels) {
+                res = WALK_HIT; /* entered after a tie above */
+                break;
+            }
+            const uint64_t n = P + oct_popcount64(M & ((1u << ci) - 1u));
+            const oct_children ch = oct_node_children(groups[d], n);
+            Mn = ch.mask;
+            Pn = ch.first;
+        look:;
+            /* enter's mid-plane times, and the children they make the ray visit */
+            const uint32_t half = size >> 1;
+            const __m128i H = _mm_set1_epi32((int32_t)half);
+            const __m128i MID = _mm_add_epi32(V, H);
+            const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ax->ZOxy), ax->ZIxy);
+            const __m128d TMzw = _mm_mul_pd(
+                _mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ax->ZOzw), ax->ZIzw);
+            const __m128d m2 = _mm_min_pd(Txy, Tzw);
+            const __m128d LIM = _mm_min_pd(_mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)), TEND);
+            /* one 32-bit lane per axis (w: 0) for each comparison, read by one movemask */
+            const unsigned near = (unsigned)_mm_movemask_ps(
+                _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TC, TMxy)),
+                               _mm_castpd_ps(_mm_cmplt_pd(TC, TMzw)), _MM_SHUFFLE(2, 0, 2, 0)));
+            const unsigned before = (unsigned)_mm_movemask_ps(
+                _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TMxy, LIM)),
+                               _mm_castpd_ps(_mm_cmplt_pd(TMzw, LIM)), _MM_SHUFFLE(2, 0, 2, 0)));
+            const unsigned order = (unsigned)_mm_movemask_ps(_mm_shuffle_ps(
+                                       _mm_castpd_ps(_mm_cmplt_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))),
+                                       _mm_castpd_ps(_mm_cmplt_pd(TMxy, TMzw)), _MM_SHUFFLE(0, 0, 2, 0))) &
+                                   7u;
+            const unsigned c0 = near ^ far;
+            const unsigned crossed = near & before;
+            if (!(trace_path_children[c0 | crossed << 3 | order << 6] & Mn)) {
+                if (d != floor)
+                    goto step; /* nothing on the way: as an empty cell */
+                if (!floor)
+                    break; /* the root */
+                goto leave; /* the walk's own cell */
+            }
+            if (d + 1 == levels) {
+                /* the set is exact unless two crossed mid planes tie */
+                const unsigned eq =
+                    (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))) |
+                    ((unsigned)_mm_movemask_pd(_mm_cmpeq_sd(TMxy, TMzw)) & 1u) << 2;
+                if (!(eq & TRACE_PAIRS(crossed))) {
+                    res = WALK_HIT; /* a voxel on the way */
+                    break;
+                }
+            }
+            /* push the cell and enter its child c0 (enter's blend) */
+            fr[d].mask = Mn;
+            fr[d].prefix = Pn;
+            fr[d].ci = ci;
+            M = Mn;
+            P = Pn;
+            TPxy = Txy;
+            TPzw = Tzw;
+            Txy = _mm_blendv_pd(TPxy, TMxy, _mm_load_pd(trace_near64[near][0]));
+            Tzw = _mm_blendv_pd(TPzw, TMzw, _mm_load_pd(trace_near64[near][1]));
+            ci = c0;
+            V = _mm_or_si128(V, _mm_and_si128(H, _mm_load_si128((const __m128i *)trace_lut[ci])));
+            size = half;
+            d++;
+            continue;
+        }
+    step:;
+        const __m128d s2 = _mm_min_pd(Txy, Tzw);
+        const __m128d TEv = _mm_min_pd(s2, _mm_shuffle_pd(s2, s2, 1));
+        if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
+            break;
+        __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
+        unsigned smask = (unsigned)_mm_movemask_pd(Exy) | (unsigned)_mm_movemask_pd(Ezw) << 2;
+        if ((~(ci ^ far) & smask) && !climb(fr, ax, floor, TEv, &d, &ci, &size, &V, &smask, &Exy,
+                                             &Ezw, &Txy, &Tzw, &TPxy, &TPzw, &M, &P)) {
+            /* the floor's cell left: through the stepped axes on which its
+               child (ci) is on the far half; on the others the step only
+               crosses the floor cell's mid plane (and no other axis of the
+               floor cell's exits at TEv: the child's later exits are not
+               nearer on the parent) */
+            if (floor) {
+                *exit_t = TEv;
+                *exit_mask = smask & ~(ci ^ far) & 7u;
+                res = WALK_LEFT;
+            }
+            break;
+        }
+        ci ^= smask;
+        Txy = _mm_blendv_pd(Txy, TPxy, Exy);
+        Tzw = _mm_blendv_pd(Tzw, TPzw, Ezw);
+        V = _mm_xor_si128(V, _mm_and_si128(_mm_set1_epi32((int32_t)size),
+                                           _mm_load_si128((const __m128i *)trace_lut[smask])));
+        TC = TEv;
+        continue;
+    leave:;
+        /* nothing on the way in the floor's cell: left through its exits */
+        const __m128d f2 = _mm_min_pd(Txy, Tzw);
+        const __m128d TFv = _mm_min_pd(f2, _mm_shuffle_pd(f2, f2, 1));
+        if (_mm_cvtsd_f64(TFv) >= t_end || left-- == 0)
+            break;
+        *exit_t = TFv;
+        *exit_mask = (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Txy, TFv)) |
+                     (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Tzw, TFv)) << 2;
+        res = WALK_LEFT;
+        break;
+    }
+    *left_io = left;
+    return res;
+}
+
+/* The any-hit walk (trace_impl.h): trace_traverse_sse's steps, enter and
+ * climb, with each occupied cell tested before it is entered: the children
+ * the ray visits in it (trace_path_children, from enter's mid-plane times)
+ * against its child mask. None occupied: the cell is left as if empty; a
+ * cell of voxels with one: the ray meets it. Plain rule only, every empty
+ * cell skipped whole (the split does not change the answer). */
+int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
+                       uint32_t *steps_out)
+{
+    const unsigned levels = tree->levels;
+    *steps_out = 0;
+    if (tree->node_count[0] == 0)
+        return 0;
+    const uint32_t max_steps = trace_max_steps(levels);
+    uint32_t left = max_steps; /* steps left: counted down */
+    const oct_group *const *groups = tree->groups;
+
+    sse_axes ax;
+    __m128d TPxy, TPzw, Txy, Tzw;
+    sse_axes_init(r, levels, &ax, NULL, NULL);
+
+    trace_frame fr[OCT_MAX_LEVELS];
+    uint32_t M = groups[0][0].mask[0], Mn;
+    uint64_t P = groups[0][0].base, Pn;
+    fr[0].mask = M;
+    fr[0].prefix = P;
+    fr[0].ci = 0;
+    unsigned d = 0, ci = 0;
+    uint32_t size = UINT32_C(1) << levels;
+    __m128i V = _mm_setzero_si128();
+
+    if (anchor && anchor->depth) {
+        /* the anchor's cell is the current one: tested like any other */
+        d = anchor->depth;
+        memcpy(fr, anchor->node, (d + 1u) * sizeof fr[0]); /* frames 0..d, one layout */
+        size = UINT32_C(1) << (levels - d);
+        V = _mm_setr_epi32((int32_t)anchor->cell[0], (int32_t)anchor->cell[1],
+                           (int32_t)anchor->cell[2], 0);
+        trace_cell_exits(V, 2u * size, &ax, &TPxy, &TPzw);
+        ci = fr[d].ci;
+        M = fr[d - 1].mask;
+        P = fr[d - 1].prefix;
+        Mn = fr[d].mask;
+        Pn = fr[d].prefix;
+    } else {
+        /* from the root, tested like any other cell (its exits: sse_axes_init's) */
+        TPxy = TPzw = _mm_setzero_pd(); /* the root has no parent: never read */
+        Mn = M;
+        Pn = P;
+    }
+    trace_cell_exits(V, size, &ax, &Txy, &Tzw);
+    __m128d exit_t; /* not set: the floor is the root */
+    unsigned exit_mask;
+    const int hit = occluded_walk(groups, &ax, levels, 0, fr, d, ci, size, V, Txy, Tzw, TPxy, TPzw,
+                                  _mm_set1_pd(r->t_start), M, P, Mn, Pn, r->t_end, &left, &exit_t,
+                                  &exit_mask) == WALK_HIT;
+    *steps_out = max_steps - left; /* max_steps + 1 when the bound was passed */
+    return hit;
+}
 
 /* The ray's cell of `shift`-voxel cells along active axis a at t, by the
  * tie rule of trace.h on the cells' planes (voxel planes, whose T() the walk
