@@ -83,7 +83,8 @@ static void row_step(uint8_t *v, const uint8_t *occ, size_t n)
 #ifdef __SSE2__
     const __m128i ONE = _mm_set1_epi8(1), CAP = _mm_set1_epi8((char)AO_GRID_MAX_CLEARANCE);
     for (; x + 16 <= n; x += 16) {
-        const __m128i m = _mm_min_epu8(_mm_adds_epu8(_mm_loadu_si128((const __m128i *)(v + x)), ONE), CAP);
+        const __m128i m1 = _mm_adds_epu8(_mm_loadu_si128((const __m128i *)(v + x)), ONE);
+        const __m128i m = _mm_min_epu8(m1, CAP);
         const __m128i empty = _mm_cmpeq_epi8(_mm_loadu_si128((const __m128i *)(occ + x)),
                                              _mm_setzero_si128());
         _mm_storeu_si128((__m128i *)(v + x), _mm_and_si128(m, empty));

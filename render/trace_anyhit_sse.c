@@ -58,10 +58,12 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
             const unsigned before = (unsigned)_mm_movemask_ps(
                 _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TMxy, LIM)),
                                _mm_castpd_ps(_mm_cmplt_pd(TMzw, LIM)), _MM_SHUFFLE(2, 0, 2, 0)));
-            const unsigned order = (unsigned)_mm_movemask_ps(_mm_shuffle_ps(
-                                       _mm_castpd_ps(_mm_cmplt_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))),
-                                       _mm_castpd_ps(_mm_cmplt_pd(TMxy, TMzw)), _MM_SHUFFLE(0, 0, 2, 0))) &
-                                   7u;
+            const __m128d YZ = _mm_shuffle_pd(TMxy, TMzw, 1); /* (y, z) */
+            const unsigned order =
+                (unsigned)_mm_movemask_ps(_mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TMxy, YZ)),
+                                                         _mm_castpd_ps(_mm_cmplt_pd(TMxy, TMzw)),
+                                                         _MM_SHUFFLE(0, 0, 2, 0))) &
+                7u;
             const unsigned c0 = near ^ far;
             const unsigned crossed = near & before;
             if (!(trace_path_children[c0 | crossed << 3 | order << 6] & Mn)) {
@@ -74,7 +76,7 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
             if (d + 1 == levels) {
                 /* the set is exact unless two crossed mid planes tie */
                 const unsigned eq =
-                    (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(TMxy, _mm_shuffle_pd(TMxy, TMzw, 1))) |
+                    (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(TMxy, YZ)) |
                     ((unsigned)_mm_movemask_pd(_mm_cmpeq_sd(TMxy, TMzw)) & 1u) << 2;
                 if (!(eq & TRACE_PAIRS(crossed))) {
                     res = WALK_HIT; /* a voxel on the way */

@@ -58,6 +58,9 @@ int trace_occluded_portable(const oct_tree *tree, const trace_ray *r, const trac
 #if TRACE_HAVE_SSE
 int trace_occluded_sse(const oct_tree *tree, const trace_ray *r, const trace_anchor *anchor,
                        uint32_t *steps);
+/* The any-hit walk of an AO ray through the clearance grid g of tree
+ * (render/ao_grid.h): the same answer as trace_occluded_sse (another step
+ * count). A ray with a zero axis takes trace_occluded_sse. */
 struct ao_grid;
 int trace_occluded_grid_sse(const oct_tree *tree, const struct ao_grid *g, const trace_ray *r,
                             const trace_anchor *anchor, uint32_t *steps);

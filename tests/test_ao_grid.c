@@ -263,7 +263,8 @@ static void check_rays(const oct_tree *t, unsigned long count, walk_stats *st)
                     continue;
                 const uint32_t cc[3] = {c % n, c / n % n, c / n / n};
                 for (int a = 0; a < 3; a++) {
-                    const double v = ((double)cc[a] + 3.0 * urand() - 1.0) * (double)(1u << g.shift);
+                    const double v =
+                        ((double)cc[a] + 3.0 * urand() - 1.0) * (double)(1u << g.shift);
                     o[a] = v < 0.0 ? 0.0 : v > lim ? (double)lim : v;
                 }
                 break;
