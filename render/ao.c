@@ -112,6 +112,9 @@ static float open_fraction(const oct_tree *tree, const trace_opts *opts, trace_t
     const trace_occluded_fn occluded = shadow_any_hit(opts, traverse);
     if (!ao_grid_wanted(opts, traverse))
         grid = NULL;
+#if !TRACE_HAVE_SSE
+    (void)grid; /* none is wanted in this build */
+#endif
     for (unsigned k = k0; k < k0 + count; k++) {
         double d[3];
         ao_direction_in(&f, k, m, d);

@@ -23,7 +23,6 @@
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15u;
 static uint64_t rng(void) { return rng_xorshift64star(&rng_state); }
-static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
 static uint32_t irand(uint32_t n) { return (uint32_t)(rng() % n); }
 
 /* Voxels in a few clusters (AO's case: surfaces with empty space between)
@@ -192,6 +191,8 @@ static void test_too_shallow(void **state)
 }
 
 #if TRACE_HAVE_SSE
+static double urand(void) { return (double)(rng() >> 11) * 0x1p-53; }
+
 /* A start coordinate: on a grid plane, a cell's plane, a voxel's middle,
  * or anywhere. */
 static double pick_coord(uint32_t lim, unsigned shift)
