@@ -242,11 +242,8 @@ void exact_scene_free(exact_scene *es)
     memset(es, 0, sizeof *es);
 }
 
-int exact_worker_init(exact_worker *w, const exact_scene *es)
+void exact_worker_new_frame(exact_worker *w)
 {
-    w->scene = es;
-    w->fast = w->slow = 0;
-    w->bound_min_n = EXACT_BOUND_MIN_N;
     w->key_slot = UINT32_MAX;
     w->key_t = 0.0;
     w->have = 0;
@@ -256,6 +253,14 @@ int exact_worker_init(exact_worker *w, const exact_scene *es)
     /* (no ray's: its d is finite and not all 0) */
     for (int a = 0; a < 6; a++)
         w->ray_od[a] = NAN;
+}
+
+int exact_worker_init(exact_worker *w, const exact_scene *es)
+{
+    w->scene = es;
+    w->fast = w->slow = 0;
+    w->bound_min_n = EXACT_BOUND_MIN_N;
+    exact_worker_new_frame(w);
     w->bound = malloc((es->ncand ? es->ncand : 1) * sizeof *w->bound);
     w->bound_state = calloc(es->ncand ? es->ncand : 1, 1);
     if (!w->bound || !w->bound_state || exact_scratch_init(&w->scratch, es->max_n)) {

@@ -104,6 +104,9 @@ typedef struct exact_worker {
 
 int exact_worker_init(exact_worker *w, const exact_scene *es); /* 0, or -1: out of memory */
 void exact_worker_free(exact_worker *w);
+/* Forgets the last line and its models (a worker kept from frame to frame
+ * keeps its sub-cells and bounds; a ray's hit never depends on them). */
+void exact_worker_new_frame(exact_worker *w);
 
 /* The exact test in occupied voxel v (integer corner), which the ray r
  * occupies for local t in [t_in, t_out]: the nearest root of any surface

@@ -406,32 +406,42 @@ static int run_pass(frame_shared *sh, int phase)
     return rc;
 }
 
-/* One exact worker (scratch) for each thread of a pass; 0, or -1 when
- * they cannot be had. */
-static int exact_workers_init(frame_sync *sy, const frame_job *job)
+static void exact_workers_free(frame_keep *k)
 {
+    for (unsigned i = 0; k->exact && i < k->exact_n; i++)
+        exact_worker_free(&k->exact[i]);
+    free(k->exact);
+    k->exact = NULL;
+    k->exact_n = 0;
+    k->exact_scene = NULL;
+}
+
+/* One exact worker for each thread of a pass: those kept in k for the same
+ * scene and as many threads, else made anew (and kept there); 0, or -1
+ * when they cannot be had. */
+static int exact_workers(frame_keep *k, const frame_job *job, exact_worker **out)
+{
+    *out = NULL;
     if (!job->exact)
         return 0;
     const unsigned n = job->threads > 1 ? job->threads : 1;
-    sy->exact = calloc(n, sizeof *sy->exact);
-    unsigned k = 0;
-    while (sy->exact && k < n && exact_worker_init(&sy->exact[k], job->exact) == 0)
-        k++;
-    if (sy->exact && k == n)
+    if (k->exact && k->exact_scene == job->exact && k->exact_n == n) {
+        for (unsigned i = 0; i < n; i++)
+            exact_worker_new_frame(&k->exact[i]);
+        *out = k->exact;
         return 0;
-    for (unsigned i = 0; sy->exact && i < k; i++)
-        exact_worker_free(&sy->exact[i]);
-    free(sy->exact);
-    sy->exact = NULL;
-    return -1;
-}
-
-static void exact_workers_free(frame_sync *sy, const frame_job *job)
-{
-    const unsigned n = job->threads > 1 ? job->threads : 1;
-    for (unsigned k = 0; sy->exact && k < n; k++)
-        exact_worker_free(&sy->exact[k]);
-    free(sy->exact);
+    }
+    exact_workers_free(k);
+    k->exact = calloc(n, sizeof *k->exact);
+    while (k->exact && k->exact_n < n && exact_worker_init(&k->exact[k->exact_n], job->exact) == 0)
+        k->exact_n++;
+    if (!k->exact || k->exact_n < n) {
+        exact_workers_free(k);
+        return -1;
+    }
+    k->exact_scene = job->exact;
+    *out = k->exact;
+    return 0;
 }
 
 static void border_free(frame_keep *k)
@@ -448,7 +458,7 @@ void frame_keep_free(frame_keep *k)
     shadow_map_cache_free(&k->maps);
     ao_grid_free(&k->grid);
     k->grid_tree = NULL;
-    border_free(k);
+    border_free(k);    exact_workers_free(k);
 }
 
 /* Border probes for ntiles tiles in k: those kept when there are enough
@@ -474,7 +484,9 @@ int frame_render(const frame_job *job, frame_stats *stats)
     memset(stats, 0, sizeof *stats);
     frame_sync sy;
     memset(&sy, 0, sizeof sy);
-    if (exact_workers_init(&sy, job) != 0)
+    frame_keep own = {0};
+    frame_keep *keep = job->keep ? job->keep : &own;
+    if (exact_workers(keep, job, &sy.exact) != 0)
         return -1;
     frame_shared sh;
     memset(&sh, 0, sizeof sh);
@@ -491,8 +503,6 @@ int frame_render(const frame_job *job, frame_stats *stats)
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     const size_t ntiles = (size_t)sh.tiles_x * sh.tiles_y;
     int rc = 0;
-    frame_keep own = {0};
-    frame_keep *keep = job->keep ? job->keep : &own;
     if (job->shade.shadows) {
         /* made before the passes on all the threads (or kept from the last
            frame): its time is the shadow rays' */
@@ -535,7 +545,6 @@ int frame_render(const frame_job *job, frame_stats *stats)
             rc1 = rc2;
     }
     frame_keep_free(&own);
-    exact_workers_free(&sy, job);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;
     stats->hits = sy.sum.hits;

@@ -57,9 +57,11 @@ typedef struct frame_job {
 
 /* What a run of frames keeps from one to the next (render's views loop):
  * the light's shadow map, made again only for another light or when a
- * finer one is wanted (shadow_map_cached), and the antialiasing pass's
- * tile border probes, grown as the images do (a mapping made anew each
- * frame costs a page fault a page). Zeroed to start; frame_keep_free at
+ * finer one is wanted (shadow_map_cached), the antialiasing pass's tile
+ * border probes, grown as the images do (a mapping made anew each frame
+ * costs a page fault a page), and --exact's workers with the sub-cells and
+ * a-priori bounds they made (what they hold changes the work, never a
+ * result: exact_sub.h, exact_scene.h). Zeroed to start; frame_keep_free at
  * the end. */
 typedef struct frame_keep {
     shadow_map_cache maps;
@@ -68,6 +70,9 @@ typedef struct frame_keep {
     aa_probe *border;      /* border_tiles tiles' probes, or NULL */
     uint8_t *border_hit;   /* a byte a tile */
     size_t border_tiles;
+    exact_worker *exact;   /* exact_n workers for the scene exact_scene, or NULL */
+    unsigned exact_n;
+    const exact_scene *exact_scene;
 } frame_keep;
 
 void frame_keep_free(frame_keep *k);

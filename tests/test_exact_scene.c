@@ -31,8 +31,8 @@ static void look(camera *cam, const double eye[3], const double target[3], uint3
 }
 
 /* --exact image (depth, float normals) through frame_render, beam on or off */
-static void render_exact(const exact_built *b, const camera *cam, unsigned beam, float *depth,
-                         float *nrm)
+static void render_exact_kept(const exact_built *b, const camera *cam, unsigned beam,
+                              frame_keep *keep, float *depth, float *nrm)
 {
     const size_t px = (size_t)cam->width * cam->height;
     uint8_t *rgb = malloc(px * 3);
@@ -50,9 +50,16 @@ static void render_exact(const exact_built *b, const camera *cam, unsigned beam,
     job.normals_f = nrm;
     job.threads = 2;
     job.beam_size = beam;
+    job.keep = keep;
     frame_stats st;
     assert_int_equal(frame_render(&job, &st), 0);
     free(rgb);
+}
+
+static void render_exact(const exact_built *b, const camera *cam, unsigned beam, float *depth,
+                         float *nrm)
+{
+    render_exact_kept(b, cam, beam, NULL, depth, nrm);
 }
 
 /* The issue's targets against refcast: mean depth error <= 0.001 voxel,
@@ -450,6 +457,43 @@ static void test_ray_alone(void **state)
     exact_built_free(&b);
 }
 
+/* A run of views keeps its exact workers (frame_keep), with the sub-cells
+ * and bounds they made and the last ray of the frame before: every frame
+ * is bit for bit the one a fresh frame gives, views repeated or not. */
+static void test_views_keep_workers(void **state)
+{
+    (void)state;
+    exact_built b;
+    exact_built_make("bounds -1.1 -1.1 -1.1 1.1 1.1 1.1\n"
+                     "surface max(max(abs(x), abs(y), abs(z)) - 0.8, x^2 + y^2 + z^2 - 1.0,"
+                     " 0.16 - min(x^2 + y^2, y^2 + z^2, z^2 + x^2))\n"
+                     "surface exp(-3*((x-0.2)^2 + y^2 + z^2)) + exp(-3*(x^2 + (y-0.3)^2 + z^2))"
+                     " + exp(-3*(x^2 + y^2 + (z+0.2)^2)) + 0.2*x - 1.1\n",
+                     8, EXACT_CELL_DEPTH, &b);
+    enum { N = 48, PX = N * N };
+    const double eyes[][3] = {{2.2, 1.6, 1.9}, {-2.4, 2.0, 1.0}, {2.2, 1.6, 1.9}, {0.5, -3.0, 2.5},
+                              {-2.4, 2.0, 1.0}};
+    static float d[PX], n[3 * PX], d0[PX], n0[3 * PX];
+    frame_keep keep;
+    memset(&keep, 0, sizeof keep);
+    size_t hits = 0;
+    for (size_t v = 0; v < sizeof eyes / sizeof eyes[0]; v++) {
+        camera cam;
+        look(&cam, eyes[v], centre, N);
+        render_exact_kept(&b, &cam, FRAME_BEAM_DEFAULT, &keep, d, n);
+        assert_non_null(keep.exact);
+        render_exact(&b, &cam, FRAME_BEAM_DEFAULT, d0, n0);
+        assert_memory_equal(d, d0, sizeof d);
+        assert_memory_equal(n, n0, sizeof n);
+        for (size_t k = 0; k < PX; k++)
+            hits += d[k] < INFINITY;
+    }
+    assert_true(hits > PX); /* the views see the surfaces */
+    frame_keep_free(&keep);
+    assert_null(keep.exact);
+    exact_built_free(&b);
+}
+
 /* The coarse cells: a far surface is no candidate in a cell it cannot
  * reach, and a long sum of far blobs is pruned to a few instructions. */
 static void test_cells_prune(void **state)
@@ -494,6 +538,7 @@ int main(void)
         cmocka_unit_test(test_roots_on_faces),
         cmocka_unit_test(test_fast_vs_fallback),
         cmocka_unit_test(test_ray_alone),
+        cmocka_unit_test(test_views_keep_workers),
         cmocka_unit_test(test_cells_prune),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
