@@ -14,6 +14,7 @@
 #include <x86intrin.h>
 #endif
 
+#include "common/limits.h"
 #include "common/test_hooks.h"
 #include "common/view/image.h"
 #include "render/ao.h"
@@ -23,15 +24,61 @@
 
 /* What the threads of a frame share and change. */
 typedef struct frame_sync {
-    atomic_uint_fast64_t next, done;
+    /* A band of tiles a thread (frame_bands_init): its first tile (low 32
+     * bits) and one past its last (high 32 bits). */
+    atomic_uint_fast64_t band[THREADS_MAX];
+    unsigned nbands; /* the pass's threads (at most THREADS_MAX) */
+    atomic_uint next_slot; /* a thread's band and exact worker */
+    atomic_uint_fast64_t done;
     atomic_int changed; /* set when map_guard abandoned a thread's work */
     pthread_mutex_t lock; /* guards the sums below */
     frame_acc sum;
     double pass_ns; /* thread time of the passes, secondary rays left out */
     double shadow_ns, ao_ns, sample_ns; /* the threads' frame_acc ticks, in ns */
     exact_worker *exact; /* with --exact: one per thread of a pass, else NULL */
-    atomic_uint next_exact;
 } frame_sync;
+
+/* The tiles split into one band of whole rows of tiles a thread, each
+ * taken from its front by its own thread and from its back by threads whose
+ * band is done: a thread meets the same part of the image frame after
+ * frame, and the threads' parts are apart, so that what a thread keeps
+ * (its --exact worker's sub-cells) is made once and stays warm, where tiles
+ * dealt out in turn make each thread build what the other did. Which
+ * thread renders a tile never changes its pixels. */
+static void frame_bands_init(frame_sync *sy, uint64_t total)
+{
+    for (unsigned k = 0; k < sy->nbands; k++) {
+        const uint64_t a = total * k / sy->nbands, b = total * (k + 1) / sy->nbands;
+        atomic_store(&sy->band[k], b << 32 | a);
+    }
+}
+
+/* A tile of band r, from its front or (back) its back: 1, or 0 when the
+ * band is done. */
+static int band_take(atomic_uint_fast64_t *r, int back, uint64_t *tile)
+{
+    uint_fast64_t cur = atomic_load_explicit(r, memory_order_relaxed);
+    for (;;) {
+        const uint64_t a = cur & 0xffffffffu, b = cur >> 32;
+        if (a >= b)
+            return 0;
+        const uint64_t nxt = back ? (b - 1) << 32 | a : b << 32 | (a + 1);
+        if (atomic_compare_exchange_weak(r, &cur, nxt)) {
+            *tile = back ? b - 1 : a;
+            return 1;
+        }
+    }
+}
+
+/* The next tile for the thread of band `own`: its band's front, then the
+ * back of the others in turn. */
+static int next_tile(frame_sync *sy, unsigned own, uint64_t *tile)
+{
+    for (unsigned k = 0; k < sy->nbands; k++)
+        if (band_take(&sy->band[(own + k) % sy->nbands], k != 0, tile))
+            return 1;
+    return 0;
+}
 
 
 double frame_now_ns(void)
@@ -311,9 +358,11 @@ static void work(const frame_shared *common, int caller)
     frame_job own; /* with --exact: the job with this thread's exact worker */
     frame_tile tile; /* with --aa: the probes of the tile being rendered */
     sh->tile = sh->border ? &tile : NULL;
+    /* (one a thread: at most job->threads of them run a pass) */
+    const unsigned slot = atomic_fetch_add(&sy->next_slot, 1);
     if (sy->exact) {
         own = *sh->job;
-        own.opts.exact = &sy->exact[atomic_fetch_add(&sy->next_exact, 1)];
+        own.opts.exact = &sy->exact[slot];
         sh->job = &own;
     }
     const uint64_t total = (uint64_t)sh->tiles_x * sh->tiles_y;
@@ -324,8 +373,8 @@ static void work(const frame_shared *common, int caller)
     for (;;) {
         if (atomic_load_explicit(&sy->changed, memory_order_relaxed))
             break; /* another thread met the file changing: stop */
-        uint64_t t = atomic_fetch_add(&sy->next, 1);
-        if (t >= total)
+        uint64_t t;
+        if (!next_tile(sy, slot % sy->nbands, &t))
             break;
         render_tile(sh, &acc, (uint32_t)(t % sh->tiles_x), (uint32_t)(t / sh->tiles_x));
         uint64_t d = atomic_fetch_add(&sy->done, 1) + 1;
@@ -385,9 +434,9 @@ static void *worker(void *arg)
 static int run_pass(frame_shared *sh, int phase)
 {
     sh->phase = phase;
-    atomic_store(&sh->sync->next, 0);
+    frame_bands_init(sh->sync, (uint64_t)sh->tiles_x * sh->tiles_y);
     atomic_store(&sh->sync->done, 0);
-    atomic_store(&sh->sync->next_exact, 0);
+    atomic_store(&sh->sync->next_slot, 0);
     unsigned extra = sh->job->threads > 1 ? sh->job->threads - 1 : 0;
     pthread_t *tid = extra ? calloc(extra, sizeof *tid) : NULL;
     int rc = 0;
@@ -495,10 +544,10 @@ int frame_render(const frame_job *job, frame_stats *stats)
     sh.traverse = job->traverse ? job->traverse : trace_impls[0].traverse;
     sh.tiles_x = (job->cam->width + FRAME_TILE - 1) / FRAME_TILE;
     sh.tiles_y = (job->cam->height + FRAME_TILE - 1) / FRAME_TILE;
-    atomic_init(&sy.next, 0);
+    sy.nbands = job->threads < 1 ? 1 : job->threads > THREADS_MAX ? THREADS_MAX : job->threads;
     atomic_init(&sy.done, 0);
     atomic_init(&sy.changed, 0);
-    atomic_init(&sy.next_exact, 0);
+    atomic_init(&sy.next_slot, 0);
     pthread_mutex_init(&sy.lock, NULL);
     const size_t npx = (size_t)job->cam->width * job->cam->height;
     const size_t ntiles = (size_t)sh.tiles_x * sh.tiles_y;
