@@ -11,7 +11,8 @@
  * the reduction in two steps (Cody and Waite: ln2's high part has its low
  * 21 bits zero, so k * LN2_HI is exact for |k| < 2^21); e^r by its Taylor
  * series to degree 13 (remainder below 2^-57 relative), evaluated as
- * 1 + (r + (c + r^2 q(r))), c what the rounding of r lost, so that the last
+ * 1 + (r + (c + r^2 q(r))), q by Estrin's scheme, c what the rounding of r
+ * lost, so that the last
  * rounding is of the sum with 1; then
  * times 2^k in two factors 2^k1 2^k2 (k1 = floor(k / 2)), each a normal
  * double, so results in the subnormal range are rounded once, by the
@@ -50,19 +51,20 @@ static inline __attribute__((always_inline)) double exp_kernel(double x)
     const double hi = x - k * ln2_hi, lo = k * ln2_lo; /* hi exact */
     const double r = hi - lo;
     const double c = (hi - r) - lo; /* what r's rounding lost (|lo| <= |hi| or r = 0) */
-    double q = 0x1.6124613a86d09p-33; /* 1/13! */
-    q = q * r + 0x1.1eed8eff8d898p-29;  /* 1/12! */
-    q = q * r + 0x1.ae64567f544e4p-26;  /* 1/11! */
-    q = q * r + 0x1.27e4fb7789f5cp-22;  /* 1/10! */
-    q = q * r + 0x1.71de3a556c734p-19;  /* 1/9! */
-    q = q * r + 0x1.a01a01a01a01ap-16;  /* 1/8! */
-    q = q * r + 0x1.a01a01a01a01ap-13;  /* 1/7! */
-    q = q * r + 0x1.6c16c16c16c17p-10;  /* 1/6! */
-    q = q * r + 0x1.1111111111111p-7;   /* 1/5! */
-    q = q * r + 0x1.5555555555555p-5;   /* 1/4! */
-    q = q * r + 0x1.5555555555555p-3;   /* 1/3! */
-    q = q * r + 0.5;                    /* 1/2! */
-    const double p = 1.0 + (r + (c + (r * r) * q));
+    /* q(r) = 1/2! + r/3! + ... + r^11/13! by Estrin's scheme: pairs, then
+     * pairs of pairs with r^2, r^4, r^8 (a chain of 6 roundings where
+     * Horner's has 24: an exact hit's evaluations wait on it, the lanes do
+     * not mind) */
+    const double r2 = r * r, r4 = r2 * r2, r8 = r4 * r4;
+    const double q01 = 0.5 + r * 0x1.5555555555555p-3;                  /* 1/2!, 1/3! */
+    const double q23 = 0x1.5555555555555p-5 + r * 0x1.1111111111111p-7; /* 1/4!, 1/5! */
+    const double q45 = 0x1.6c16c16c16c17p-10 + r * 0x1.a01a01a01a01ap-13; /* 1/6!, 1/7! */
+    const double q67 = 0x1.a01a01a01a01ap-16 + r * 0x1.71de3a556c734p-19; /* 1/8!, 1/9! */
+    const double q89 = 0x1.27e4fb7789f5cp-22 + r * 0x1.ae64567f544e4p-26; /* 1/10!, 1/11! */
+    const double qab = 0x1.1eed8eff8d898p-29 + r * 0x1.6124613a86d09p-33; /* 1/12!, 1/13! */
+    const double q03 = q01 + r2 * q23, q47 = q45 + r2 * q67, q8b = q89 + r2 * qab;
+    const double q = (q03 + r4 * q47) + r8 * q8b;
+    const double p = 1.0 + (r + (c + r2 * q));
     /* k's two's complement from t's low bits; k1 = k >> 1 (arithmetic),
      * k2 = k - k1; for -746 <= x <= 710, |k| <= 1077 and both 2^k1 and 2^k2
      * are normal */
