@@ -49,8 +49,7 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
             const __m128d TMxy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(MID), ax->ZOxy), ax->ZIxy);
             const __m128d TMzw = _mm_mul_pd(
                 _mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(MID, MID)), ax->ZOzw), ax->ZIzw);
-            const __m128d m2 = _mm_min_pd(Txy, Tzw);
-            const __m128d LIM = _mm_min_pd(_mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)), TEND);
+            const __m128d LIM = _mm_min_pd(sse_min3(Txy, Tzw), TEND);
             /* one 32-bit lane per axis (w: 0) for each comparison, read by one movemask */
             const unsigned near = (unsigned)_mm_movemask_ps(
                 _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(TC, TMxy)),
@@ -100,8 +99,7 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
             continue;
         }
     step:;
-        const __m128d s2 = _mm_min_pd(Txy, Tzw);
-        const __m128d TEv = _mm_min_pd(s2, _mm_shuffle_pd(s2, s2, 1));
+        const __m128d TEv = sse_min3(Txy, Tzw);
         if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
             break;
         __m128d Exy = _mm_cmpeq_pd(Txy, TEv), Ezw = _mm_cmpeq_pd(Tzw, TEv);
@@ -129,13 +127,11 @@ SSE_INLINE int occluded_walk(const oct_group *const *groups, const sse_axes *ax,
         continue;
     leave:;
         /* nothing on the way in the floor's cell: left through its exits */
-        const __m128d f2 = _mm_min_pd(Txy, Tzw);
-        const __m128d TFv = _mm_min_pd(f2, _mm_shuffle_pd(f2, f2, 1));
+        const __m128d TFv = sse_min3(Txy, Tzw);
         if (_mm_cvtsd_f64(TFv) >= t_end || left-- == 0)
             break;
         *exit_t = TFv;
-        *exit_mask = (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Txy, TFv)) |
-                     (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(Tzw, TFv)) << 2;
+        *exit_mask = sse_ties(Txy, Tzw, TFv);
         res = WALK_LEFT;
         break;
     }
@@ -226,16 +222,6 @@ static uint32_t grid_cell_at(const trace_ray *r, int a, double t, unsigned shift
     return m;
 }
 
-/* T() of the planes K (voxel coordinates, lanes x, y, z; w ignored) per
- * axis, the dummy lane w raised to +inf: trace_cell_exits's arithmetic. */
-SSE_INLINE void grid_plane_times(__m128i K, const sse_axes *ax, __m128d *txy, __m128d *tzw)
-{
-    *txy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(K), ax->ZOxy), ax->ZIxy);
-    *tzw = _mm_max_pd(
-        _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(K, K)), ax->ZOzw), ax->ZIzw),
-        ax->WINF);
-}
-
 /* A 3-bit mask (one bit a lane x, y, z) of the lanes set in two 64-bit
  * comparisons. */
 SSE_INLINE unsigned grid_mask(__m128d xy, __m128d zw)
@@ -324,12 +310,11 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
         if (k == 1) {
             /* the cell alone: left through its exit planes */
             __m128d Txy, Tzw;
-            grid_plane_times(_mm_sll_epi32(_mm_sub_epi32(C, ax.FARM), SH), &ax, &Txy, &Tzw);
-            const __m128d m2 = _mm_min_pd(Txy, Tzw);
-            TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
+            sse_plane_times(_mm_sll_epi32(_mm_sub_epi32(C, ax.FARM), SH), &ax, &Txy, &Tzw);
+            TEv = sse_min3(Txy, Tzw);
             if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
                 break;
-            exits = grid_mask(_mm_cmpeq_pd(Txy, TEv), _mm_cmpeq_pd(Tzw, TEv));
+            exits = sse_ties(Txy, Tzw, TEv) & 7u;
             goto next_cell;
         }
         /* the empty cube of k cells from C on the ray's side */
@@ -339,12 +324,11 @@ int trace_occluded_grid_sse(const oct_tree *tree, const ao_grid *g, const trace_
             _mm_min_epi32(_mm_add_epi32(_mm_add_epi32(C, ONE), _mm_and_si128(ax.FARM, K1)), NMAX);
         /* the box's exit: its planes on the far sides */
         __m128d Txy, Tzw;
-        grid_plane_times(_mm_sll_epi32(_mm_blendv_epi8(LO, HI, ax.FARM), SH), &ax, &Txy, &Tzw);
-        const __m128d m2 = _mm_min_pd(Txy, Tzw);
-        TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
+        sse_plane_times(_mm_sll_epi32(_mm_blendv_epi8(LO, HI, ax.FARM), SH), &ax, &Txy, &Tzw);
+        TEv = sse_min3(Txy, Tzw);
         if (_mm_cvtsd_f64(TEv) >= t_end || left-- == 0)
             break;
-        exits = grid_mask(_mm_cmpeq_pd(Txy, TEv), _mm_cmpeq_pd(Tzw, TEv));
+        exits = sse_ties(Txy, Tzw, TEv) & 7u;
         /* past the box on the exit axes; the root is left past 0 or n */
         const __m128i NEXT = _mm_blendv_epi8(_mm_sub_epi32(LO, ONE), HI, ax.FARM);
         const __m128i EM = _mm_load_si128((const __m128i *)trace_lut[exits]);

@@ -47,8 +47,7 @@ voxel_walk(const sse_axes *ax, __m128i V, uint32_t size, __m128d TC, __m128d Wxy
 {
     const unsigned far = ax->far;
     const __m128d ZOxy = ax->ZOxy, ZIxy = ax->ZIxy;
-    const __m128d c2 = _mm_min_pd(Wxy, Wzw);
-    const double te_cell = _mm_cvtsd_f64(_mm_min_pd(c2, _mm_shuffle_pd(c2, c2, 1)));
+    const double te_cell = _mm_cvtsd_f64(sse_min3(Wxy, Wzw));
     while (size > 1)
         enter(ax, TC, Wxy, Wzw, &V, &size, &Wxy, &Wzw);
     /* far-face offsets and unit moves per lane; the dummy lane w uses
@@ -58,8 +57,7 @@ voxel_walk(const sse_axes *ax, __m128i V, uint32_t size, __m128d TC, __m128d Wxy
     const __m128i DIRV = _mm_sub_epi32(_mm_add_epi32(FARV, FARV), _mm_set1_epi32(1));
     const __m128d WZOzw = _mm_setr_pd(ax->zoz, -0.5), WZIzw = _mm_setr_pd(ax->ziz, INFINITY);
     for (;;) {
-        const __m128d w2 = _mm_min_pd(Wxy, Wzw);
-        const __m128d WEv = _mm_min_pd(w2, _mm_shuffle_pd(w2, w2, 1));
+        const __m128d WEv = sse_min3(Wxy, Wzw);
         if (_mm_cvtsd_f64(WEv) >= te_cell)
             return steps;
         if (++steps > max_steps)
@@ -188,8 +186,7 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
     step:;
         /* leave the cell through its nearest exit planes (all axes whose exit
          * time is te) */
-        const __m128d m2 = _mm_min_pd(Txy, Tzw);
-        const __m128d TEv = _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1)); /* te in both lanes */
+        const __m128d TEv = sse_min3(Txy, Tzw); /* te in both lanes */
         const double te = _mm_cvtsd_f64(TEv);
         if (te >= t_end || ++steps > max_steps)
             break;

@@ -93,15 +93,36 @@ SSE_INLINE void sse_axes_init(const trace_ray *r, unsigned levels, sse_axes *ax,
  * edge `edge`, T(corner + far * edge) per axis: the same T of the same
  * planes as a descent blends from mid-plane times, bit for bit. The dummy lane
  * w comes out 0 and is raised to +inf by WINF. */
-SSE_INLINE void trace_cell_exits(__m128i V, uint32_t edge, const sse_axes *ax, __m128d *txy,
-                                 __m128d *tzw)
+/* T() of the planes K (voxel coordinates, lanes x, y, z; w ignored) per
+ * axis, the dummy lane w raised to +inf by WINF. */
+SSE_INLINE void sse_plane_times(__m128i K, const sse_axes *ax, __m128d *txy, __m128d *tzw)
 {
-    const __m128i C = _mm_andnot_si128(_mm_set1_epi32((int32_t)(edge - 1u)), V);
-    const __m128i K = _mm_add_epi32(C, _mm_and_si128(_mm_set1_epi32((int32_t)edge), ax->FARM));
     *txy = _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(K), ax->ZOxy), ax->ZIxy);
     *tzw = _mm_max_pd(
         _mm_mul_pd(_mm_sub_pd(_mm_cvtepi32_pd(_mm_unpackhi_epi64(K, K)), ax->ZOzw), ax->ZIzw),
         ax->WINF);
+}
+
+SSE_INLINE void trace_cell_exits(__m128i V, uint32_t edge, const sse_axes *ax, __m128d *txy,
+                                 __m128d *tzw)
+{
+    const __m128i C = _mm_andnot_si128(_mm_set1_epi32((int32_t)(edge - 1u)), V);
+    sse_plane_times(_mm_add_epi32(C, _mm_and_si128(_mm_set1_epi32((int32_t)edge), ax->FARM)), ax,
+                    txy, tzw);
+}
+
+/* The least of the times (x, y) and (z, w), in both lanes. */
+SSE_INLINE __m128d sse_min3(__m128d txy, __m128d tzw)
+{
+    const __m128d m2 = _mm_min_pd(txy, tzw);
+    return _mm_min_pd(m2, _mm_shuffle_pd(m2, m2, 1));
+}
+
+/* The axes whose time is t: bits x, y, z (and w, bit 3). */
+SSE_INLINE unsigned sse_ties(__m128d txy, __m128d tzw, __m128d t)
+{
+    return (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(txy, t)) |
+           (unsigned)_mm_movemask_pd(_mm_cmpeq_pd(tzw, t)) << 2;
 }
 
 

@@ -222,6 +222,23 @@ typedef struct walk_stats {
 
 /* Rays from inside the cube through tree t: the grid's walk answers as the
  * plain walk (and the traversal: an occupied voxel met or not). */
+/* An occupied cell of the grid drawn at random (its coordinates in cc):
+ * 1, or 0 when 64 draws found none. */
+static int random_occupied_cell(const ao_grid *g, uint32_t cc[3])
+{
+    const uint32_t n = g->n;
+    for (int tries = 0; tries < 64; tries++) {
+        const uint32_t c = irand(n * n * n);
+        if (AO_GRID_OCCUPIED(g->cell[c])) {
+            cc[0] = c % n;
+            cc[1] = c / n % n;
+            cc[2] = c / n / n;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 static void check_rays(const oct_tree *t, unsigned long count, walk_stats *st)
 {
     ao_grid g;
@@ -240,12 +257,8 @@ static void check_rays(const oct_tree *t, unsigned long count, walk_stats *st)
                dyadic direction: positions on cell planes at the grid's
                steps, where the cell is taken from the plane times */
             static const double comp[] = {1.0, -1.0, 2.0, -2.0, 0.5, -0.5};
-            const uint32_t n = g.n;
-            for (int tries = 0; tries < 64; tries++) {
-                const uint32_t c = irand(n * n * n);
-                if (!AO_GRID_OCCUPIED(g.cell[c]))
-                    continue;
-                const uint32_t cc[3] = {c % n, c / n % n, c / n / n};
+            uint32_t cc[3];
+            if (random_occupied_cell(&g, cc)) {
                 const double back = (double)(1 + irand(48));
                 for (int a = 0; a < 3; a++) {
                     d[a] = comp[irand(6)];
@@ -253,23 +266,16 @@ static void check_rays(const oct_tree *t, unsigned long count, walk_stats *st)
                     const double v = target - back * d[a];
                     o[a] = v < 0.0 ? 0.0 : v > lim ? (double)lim : v;
                 }
-                break;
             }
         } else if (kind == 1) {
             /* rays that start next to an occupied cell, as AO rays do */
-            const uint32_t n = g.n;
-            for (int tries = 0; tries < 64; tries++) {
-                const uint32_t c = irand(n * n * n);
-                if (!AO_GRID_OCCUPIED(g.cell[c]))
-                    continue;
-                const uint32_t cc[3] = {c % n, c / n % n, c / n / n};
+            uint32_t cc[3];
+            if (random_occupied_cell(&g, cc))
                 for (int a = 0; a < 3; a++) {
                     const double v =
                         ((double)cc[a] + 3.0 * urand() - 1.0) * (double)(1u << g.shift);
                     o[a] = v < 0.0 ? 0.0 : v > lim ? (double)lim : v;
                 }
-                break;
-            }
         }
         if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
             d[2] = 1.0;
