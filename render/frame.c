@@ -507,7 +507,8 @@ void frame_keep_free(frame_keep *k)
     shadow_map_cache_free(&k->maps);
     ao_grid_free(&k->grid);
     k->grid_tree = NULL;
-    border_free(k);    exact_workers_free(k);
+    border_free(k);
+    exact_workers_free(k);
 }
 
 /* Border probes for ntiles tiles in k: those kept when there are enough

@@ -62,7 +62,8 @@ typedef struct frame_job {
  * costs a page fault a page), and --exact's workers with the sub-cells and
  * a-priori bounds they made (what they hold changes the work, never a
  * result: exact_sub.h, exact_scene.h). Zeroed to start; frame_keep_free at
- * the end. */
+ * the end, before the tree and scene it was used with go (they are known
+ * by their address). */
 typedef struct frame_keep {
     shadow_map_cache maps;
     ao_grid grid;          /* with --ao: grid_tree's clearance grid (n = 0: none) */

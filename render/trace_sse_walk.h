@@ -89,10 +89,6 @@ SSE_INLINE void sse_axes_init(const trace_ray *r, unsigned levels, sse_axes *ax,
     }
 }
 
-/* The exit times of the cell with corner V (bits below `edge` ignored) and
- * edge `edge`, T(corner + far * edge) per axis: the same T of the same
- * planes as a descent blends from mid-plane times, bit for bit. The dummy lane
- * w comes out 0 and is raised to +inf by WINF. */
 /* T() of the planes K (voxel coordinates, lanes x, y, z; w ignored) per
  * axis, the dummy lane w raised to +inf by WINF. */
 SSE_INLINE void sse_plane_times(__m128i K, const sse_axes *ax, __m128d *txy, __m128d *tzw)
@@ -103,6 +99,10 @@ SSE_INLINE void sse_plane_times(__m128i K, const sse_axes *ax, __m128d *txy, __m
         ax->WINF);
 }
 
+/* The exit times of the cell with corner V (bits below `edge` ignored) and
+ * edge `edge`, T(corner + far * edge) per axis: the same T of the same
+ * planes as a descent blends from mid-plane times, bit for bit. The dummy lane
+ * w comes out 0 and is raised to +inf by WINF. */
 SSE_INLINE void trace_cell_exits(__m128i V, uint32_t edge, const sse_axes *ax, __m128d *txy,
                                  __m128d *tzw)
 {

@@ -12,9 +12,8 @@
  * 21 bits zero, so k * LN2_HI is exact for |k| < 2^21); e^r by its Taylor
  * series to degree 13 (remainder below 2^-57 relative), evaluated as
  * 1 + (r + (c + r^2 q(r))), q by Estrin's scheme, c what the rounding of r
- * lost, so that the last
- * rounding is of the sum with 1; then
- * times 2^k in two factors 2^k1 2^k2 (k1 = floor(k / 2)), each a normal
+ * lost, so that the last rounding is of the sum with 1; then times 2^k in
+ * two factors 2^k1 2^k2 (k1 = floor(k / 2)), each a normal
  * double, so results in the subnormal range are rounded once, by the
  * second product. Beyond -746 and 710 the result is chosen at the end
  * (+0, +inf); from 709.79 on the products overflow to +inf themselves, from
