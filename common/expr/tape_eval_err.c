@@ -51,6 +51,8 @@ static inline void scaled(tape_edir *r, const tape_edir *a, double s, double es)
     r->ed = fin(fabs(a->d) * es + fabs(s) * a->ed + a->ed * es + U * fabs(r->d));
 }
 
+#define OP TAPE_OPL
+
 int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], const double d[3],
                       tape_edir *out, tape_edir *s)
 {
@@ -62,8 +64,10 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
 #define OA (&s[in[i].a])
 #define OC (&s[in[i].b])
         int ok = 1;
-        switch ((tape_op)in[i].op) {
-        case TAPE_CONST: {
+        /* (tape_int.h's dispatch; an op's code ends at `checked`, the test
+           every op's result takes) */
+        TAPE_DISPATCH(in[i].op) {
+        OP(CONST): {
             const tape_const *kk = &k[in[i].a];
             r->v = kk->v;
             const double lo = kk->v - kk->lo, hi = kk->hi - kk->v;
@@ -71,28 +75,28 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             ok = small(r->v);
             r->d = 0.0;
             r->ed = 0.0;
-            break;
+            goto checked;
         }
-        case TAPE_X: case TAPE_Y: case TAPE_Z:
+        OP(X): OP(Y): OP(Z):
             r->v = p[in[i].op - TAPE_X];
             r->ev = ep[in[i].op - TAPE_X];
             r->d = d[in[i].op - TAPE_X];
             r->ed = 0.0;
             ok = small(r->v) & small(r->d);
-            break;
-        case TAPE_NEG:
+            goto checked;
+        OP(NEG):
             r->v = -OA->v;
             r->ev = OA->ev;
             r->d = -OA->d;
             r->ed = OA->ed;
-            break;
-        case TAPE_SQUARE:
+            goto checked;
+        OP(SQUARE):
             /* |â² - a²| <= ea (2|â| + ea) */
             r->v = OA->v * OA->v;
             r->ev = fin(OA->ev * (2.0 * fabs(OA->v) + OA->ev) + U * r->v);
             scaled(r, OA, 2.0 * OA->v, 2.0 * OA->ev);
-            break;
-        case TAPE_SQRT: {
+            goto checked;
+        OP(SQRT): {
             /* a >= â - ea >= SMALL; |√â - √a| <= ea / √â */
             if (!(OA->v - OA->ev >= SMALL))
                 return 0;
@@ -103,17 +107,17 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             if (!(ls >= SMALL))
                 return 0;
             scaled(r, OA, sc, fin(U * sc + 0.5 * r->ev / (r->v * ls)));
-            break;
+            goto checked;
         }
-        case TAPE_EXP:
+        OP(EXP):
             /* |exp(â) - exp(a)| <= exp(â) (e^ea - 1) <= exp(â) ea (1 + ea) */
             if (!(OA->ev <= 0.0625 && OA->v <= 69.0)) /* (e^69 < BIG: no overflow) */
                 return 0;
             r->v = exp_kernel(OA->v);
             r->ev = fin(LIB * r->v + r->v * (1.0 + LIB) * OA->ev * (1.0 + OA->ev));
             scaled(r, OA, r->v, r->ev);
-            break;
-        case TAPE_LOG: {
+            goto checked;
+        OP(LOG): {
             /* a >= l = â - ea >= SMALL: |log â - log a| <= ea / l,
              * |1/â - 1/a| <= ea / (â l) */
             const double l = OA->v - OA->ev;
@@ -123,17 +127,17 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             r->ev = fin(LIB * fabs(r->v) + OA->ev / l);
             const double sc = 1.0 / OA->v;
             scaled(r, OA, sc, fin(U * sc + OA->ev / (OA->v * l)));
-            break;
+            goto checked;
         }
-        case TAPE_ABS:
+        OP(ABS):
             ok = fabs(OA->v) > OA->ev; /* a has â's sign: no kink within reach */
             r->v = fabs(OA->v);
             r->ev = OA->ev;
             r->d = OA->v < 0.0 ? -OA->d : OA->d;
             r->ed = OA->ed;
-            break;
-        case TAPE_SIN:
-        case TAPE_COS: {
+            goto checked;
+        OP(SIN):
+        OP(COS): {
             /* Taylor, |sin''|, |cos''| <= 1: |sin â - sin a| <= |cos â| ea +
              * ea²/2, |cos â - cos a| <= |sin â| ea + ea²/2 (|cos â| <= |cv|
              * (1 + LIB): cv is libm's) */
@@ -153,9 +157,9 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
                 r->ev = bc;
                 scaled(r, OA, -sv, bs);
             }
-            break;
+            goto checked;
         }
-        case TAPE_TAN: {
+        OP(TAN): {
             /* With |tan â| <= T, tau = 1.01 ea >= tan ea (ea <= 1/16) and
              * T tau <= 1/4, for |x - â| <= ea: tan x = (tan â + tan δ) /
              * (1 - tan â tan δ), |δ| <= ea, so no pole and |tan x| <= M =
@@ -173,21 +177,21 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             if (!(small(sc) & small(es)))
                 return 0;
             scaled(r, OA, sc, es);
-            break;
+            goto checked;
         }
-        case TAPE_ADD:
+        OP(ADD):
             r->v = OA->v + OC->v;
             r->d = OA->d + OC->d;
             r->ev = fin(OA->ev + OC->ev + U * fabs(r->v));
             r->ed = fin(OA->ed + OC->ed + U * fabs(r->d));
-            break;
-        case TAPE_SUB:
+            goto checked;
+        OP(SUB):
             r->v = OA->v - OC->v;
             r->d = OA->d - OC->d;
             r->ev = fin(OA->ev + OC->ev + U * fabs(r->v));
             r->ed = fin(OA->ed + OC->ed + U * fabs(r->d));
-            break;
-        case TAPE_MUL: {
+            goto checked;
+        OP(MUL): {
             r->v = OA->v * OC->v;
             r->ev = fin(fabs(OA->v) * OC->ev + fabs(OC->v) * OA->ev + OA->ev * OC->ev + U * fabs(r->v));
             const double p1 = OA->d * OC->v, p2 = OA->v * OC->d;
@@ -195,9 +199,9 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             r->ed = fin(fabs(OA->d) * OC->ev + fabs(OC->v) * OA->ed + OA->ed * OC->ev +
                         fabs(OA->v) * OC->ed + fabs(OC->d) * OA->ev + OA->ev * OC->ed +
                         U * (fabs(p1) + fabs(p2) + fabs(r->d)));
-            break;
+            goto checked;
         }
-        case TAPE_DIV: {
+        OP(DIV): {
             /* |c| >= l = |ĉ| - ec >= SMALL; â/ĉ - a/c = (â - a)/c + (â/ĉ)(c - ĉ)/c */
             const double l = fabs(OC->v) - OC->ev;
             if (!(l >= SMALL))
@@ -210,18 +214,18 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             const double en = OA->ed + fabs(r->v) * OC->ed + fabs(OC->d) * r->ev + r->ev * OC->ed +
                               U * (fabs(q) + fabs(nu));
             r->ed = fin(U * fabs(r->d) + (en + fabs(r->d) * OC->ev) / l);
-            break;
+            goto checked;
         }
-        case TAPE_MIN:
-        case TAPE_MAX: {
+        OP(MIN):
+        OP(MAX): {
             /* operands further apart than their errors: the exact values
              * take the same branch, and no kink is within reach */
             ok = fabs(OA->v - OC->v) > (OA->ev + OC->ev) * C;
             const double v = in[i].op == TAPE_MIN ? point_min(OA->v, OC->v) : point_max(OA->v, OC->v);
             *r = v == OA->v ? *OA : *OC;
-            break;
+            goto checked;
         }
-        case TAPE_POWC: {
+        OP(POWC): {
             /* a >= â - ea >= SMALL, rho = ea/â <= 1/2: for x between a and â,
              * (x/â)^(p-1) <= exp(2 rho |p-1|) <= 1 + 4 rho |p-1| when
              * 2 rho |p-1| <= 1; so |â^p - a^p| <= |p| (â^p / â)(1 + 4 rho |p-1|) ea */
@@ -246,10 +250,12 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
             if (!(small(sc) & small(es)))
                 return 0;
             scaled(r, OA, sc, es);
-            break;
+            goto checked;
         }
-        case TAPE_NOPS: ok = 0; break;
+        OP(NOPS): ok = 0; goto checked;
+        TAPE_DISPATCH_DEFAULT();
         }
+    checked:
 #undef OA
 #undef OC
         if (!(ok & bounded(r->ev, r->ed)))
@@ -258,3 +264,4 @@ int tape_eval_dir_err(const tape *t, const double p[3], const double ep[3], cons
     *out = s[t->root];
     return 1;
 }
+#undef OP
