@@ -38,8 +38,8 @@ typedef struct frame_sync {
     exact_worker *exact; /* with --exact: one per thread of a pass, else NULL */
 } frame_sync;
 
-/* The tiles split into one band of whole rows of tiles a thread, each
- * taken from its front by its own thread and from its back by threads whose
+/* The tiles split into one band a thread (a run of tiles in row order),
+ * each taken from its front by its own thread and from its back by threads whose
  * band is done: a thread meets the same part of the image frame after
  * frame, and the threads' parts are apart, so that what a thread keeps
  * (its --exact worker's sub-cells) is made once and stays warm, where tiles
@@ -79,7 +79,6 @@ static int next_tile(frame_sync *sy, unsigned own, uint64_t *tile)
             return 1;
     return 0;
 }
-
 
 double frame_now_ns(void)
 {
