@@ -248,6 +248,7 @@ void exact_worker_new_frame(exact_worker *w)
     w->key_t = 0.0;
     w->have = 0;
     w->have_curv = 0;
+    w->exit_t = NAN;
     w->line_new = 1;
     memset(w->key, 0, sizeof w->key);
     /* (no ray's: its d is finite and not all 0) */
@@ -258,7 +259,7 @@ void exact_worker_new_frame(exact_worker *w)
 int exact_worker_init(exact_worker *w, const exact_scene *es)
 {
     w->scene = es;
-    w->fast = w->slow = 0;
+    w->fast = w->slow = w->beyond = 0;
     w->bound_min_n = EXACT_BOUND_MIN_N;
     exact_worker_new_frame(w);
     w->bound = malloc((es->ncand ? es->ncand : 1) * sizeof *w->bound);
@@ -346,6 +347,46 @@ static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t,
     hit->surface = surface;
 }
 
+/* Local t where the ray leaves the coarse cell of voxel v (or the ray's
+ * end), made once a line and cell (key). */
+static double cell_exit(exact_worker *w, const trace_ray *r, const uint32_t v[3])
+{
+    if (w->exit_t != w->exit_t) {
+        const unsigned shift = w->scene->tree->levels - w->scene->depth;
+        double te = r->t_end;
+        for (int a = 0; a < 3; a++) {
+            if (!(r->active >> a & 1u))
+                continue;
+            const uint32_t c = (v[a] >> shift) + (r->sgn[a] > 0);
+            const double ta = trace_plane_time(r, a, (double)((uint64_t)c << shift));
+            te = ta < te ? ta : te;
+        }
+        w->exit_t = te;
+    }
+    return w->exit_t;
+}
+
+/* The voxel's span [a, b] holds no root of the cell's one surface: the
+ * model may still certify exactly one root on [a, exit], exit where the
+ * line leaves the cell (its box holds those points too, so the model's
+ * bounds hold there), and place it. That root is the ray's hit (the cell
+ * has no other surface, and voxels before a hold no root), so the
+ * cell's next voxels need no test. EXACT_FAST_ROOT with *t, grad; else
+ * EXACT_FAST_NONE (the voxel's own answer). */
+static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t v[3],
+                       const tape *t_exact, double a, double b, double curv, double *t,
+                       double grad[3])
+{
+    const double e = cell_exit(w, r, v);
+    if (!(e > b))
+        return EXACT_FAST_NONE;
+    if (exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad) !=
+        EXACT_FAST_ROOT)
+        return EXACT_FAST_NONE;
+    w->beyond++;
+    return EXACT_FAST_ROOT;
+}
+
 int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
                 double t_out, double *t_hit, trace_hit *hit)
 {
@@ -369,6 +410,7 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         w->key_slot = slot;
         w->have = 0;
         w->have_curv = 0;
+        w->exit_t = NAN;
     }
     w->key_t = t_in;
     double a = t_in - w->widen, b = t_out + w->widen;
@@ -422,6 +464,8 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
                                      &have, &t, grad);
                 w->have = (w->have & ~bit) | (uint32_t)have << j;
                 w->model_key[j] = key;
+                if (st == EXACT_FAST_NONE && have && key == 0 && k1 - k0 == 1)
+                    st = root_beyond(w, r, v, t_exact, a, b, curv, &t, grad);
             }
         }
         if (st == EXACT_FAST_UNDECIDED) {

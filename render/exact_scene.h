@@ -73,6 +73,7 @@ typedef struct exact_worker {
     exact_scratch scratch;
     exact_sub_cache sub; /* its own sub-cells */
     uint64_t fast, slow; /* statistics: candidate tests the fast path decided, and not */
+    uint64_t beyond;     /* statistics: hits placed past their voxel (root_beyond) */
     /* The fast path's models (exact_fast.h) for the line of the last test
      * (key: o, d; key_t: its t_in), valid while its voxels stay in one
      * coarse cell: candidate k of the cell has one when bit k of `have` is
@@ -92,6 +93,7 @@ typedef struct exact_worker {
      * differs from `key` (the models start afresh at the next voxel). */
     double ray_od[6];
     exact_line line;
+    double exit_t; /* where the line leaves the key's cell (NaN: not made) */
     double widen;
     int line_new;
     /* per candidate of the scene, made on first use: its cell's a-priori

@@ -269,8 +269,9 @@ static void test_roots_on_faces(void **state)
  * centre (aimed at distances 0.8 (1 + 2^-k) from it). The fast path takes
  * the cells' a-priori bound on every tape; with `bounded`, its evaluations
  * mostly use it
- * (tape_err_cell), and few models that it cannot decide are decided by the
- * per-point one. */
+ * (tape_err_cell), few models that it cannot decide are decided by the
+ * per-point one, and a quarter of the hits at least are placed past the
+ * voxel whose span was tested (root_beyond in exact_scene.c). */
 static void fast_vs_fallback(const char *text, const double target[3], double min_fast,
                              int bounded)
 {
@@ -359,12 +360,17 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
         }
     }
     if (getenv("EXACT_VERBOSE"))
-        printf("%u hits, %u the same (normals at most %.3g apart); fast %llu, slow %llu; a-priori bound %llu, retried "
-               "%llu, rescued %llu\n", hits, same, dn_max, (unsigned long long)w1.fast,
-               (unsigned long long)w1.slow, (unsigned long long)w1.scratch.nbound,
+        printf("%u hits, %u the same (normals at most %.3g apart); fast %llu, slow %llu, beyond "
+               "%llu; a-priori bound %llu, retried %llu, rescued %llu\n", hits, same, dn_max,
+               (unsigned long long)w1.fast, (unsigned long long)w1.slow,
+               (unsigned long long)w1.beyond, (unsigned long long)w1.scratch.nbound,
                (unsigned long long)w1.scratch.nretry, (unsigned long long)w1.scratch.nrescue);
-    if (bounded)
+    if (bounded) {
         assert_true(w1.scratch.nbound > (uint64_t)hits && w1.scratch.nrescue * 20 < hits);
+        /* most roots of a smooth surface are placed from the ray's first
+         * voxel of the cell that holds them (root_beyond) */
+        assert_true(w1.beyond * 4 >= hits);
+    }
     assert_true(hits > 500);
     assert_true(same * 3 >= hits);
     assert_true(w2.fast == 0);
