@@ -347,37 +347,40 @@ static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t,
     hit->surface = surface;
 }
 
-/* Local t where the ray leaves the coarse cell of voxel v (or the ray's
- * end), made once a line and cell (key). */
-static double cell_exit(exact_worker *w, const trace_ray *r, const uint32_t v[3])
+/* Local t where the ray leaves the region whose corner, in cells of
+ * 2^shift voxels, is c (or the ray's end), made once a line and region
+ * (exit_key; the key's reset clears it). */
+static double region_exit(exact_worker *w, const trace_ray *r, const uint32_t c[3],
+                          unsigned shift, uint64_t key)
 {
-    if (w->exit_t != w->exit_t) {
-        const unsigned shift = w->scene->tree->levels - w->scene->depth;
+    if (w->exit_t != w->exit_t || w->exit_key != key) {
         double te = r->t_end;
         for (int a = 0; a < 3; a++) {
             if (!(r->active >> a & 1u))
                 continue;
-            const uint32_t c = (v[a] >> shift) + (r->sgn[a] > 0);
-            const double ta = trace_plane_time(r, a, (double)((uint64_t)c << shift));
+            const uint64_t k = (uint64_t)c[a] + (r->sgn[a] > 0);
+            const double ta = trace_plane_time(r, a, (double)(k << shift));
             te = ta < te ? ta : te;
         }
         w->exit_t = te;
+        w->exit_key = key;
     }
     return w->exit_t;
 }
 
 /* The voxel's span [a, b] holds no root of the cell's one surface: the
- * model may still certify exactly one root on [a, exit], exit where the
- * line leaves the cell (its box holds those points too, so the model's
- * bounds hold there), and place it. That root is the ray's hit (the cell
- * has no other surface, and voxels before a hold no root), so the
- * cell's next voxels need no test. EXACT_FAST_ROOT with *t, grad; else
- * EXACT_FAST_NONE (the voxel's own answer). */
-static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t v[3],
-                       const tape *t_exact, double a, double b, double curv, double *t,
-                       double grad[3])
+ * model of the region (the coarse cell or its sub-cell: corner c, shift,
+ * key) may still certify exactly one root on [a, e], e where the line
+ * leaves the region (its box holds those points too, so the model's bounds
+ * hold there), and place it. That root is the ray's hit (the cell has no
+ * other surface, and voxels before a hold no root), so the region's next
+ * voxels need no test. EXACT_FAST_ROOT with *t, grad; else EXACT_FAST_NONE
+ * (the voxel's own answer). */
+static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t c[3], unsigned shift,
+                       uint64_t key, const tape *t_exact, double a, double b, double curv,
+                       double *t, double grad[3])
 {
-    const double e = cell_exit(w, r, v);
+    const double e = region_exit(w, r, c, shift, key);
     if (!(e > b))
         return EXACT_FAST_NONE;
     if (exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad) !=
@@ -430,6 +433,8 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         const tape *t_exact = &c->t, *t_cull = &c->cull;
         const double *hmag = c->hmag;
         uint64_t key = 0;
+        uint32_t rc[3] = {v[0] >> shift, v[1] >> shift, v[2] >> shift}; /* the region's corner */
+        unsigned rshift = shift;
         if (!(hmag[0] < INFINITY) && es->sub_max && exact_sub_wanted(c->kinks)) {
             if (!reserved) {
                 exact_sub_reserve(&w->sub);
@@ -444,6 +449,8 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
             t_cull = &rg->cull;
             hmag = rg->hmag;
             key = rg->key;
+            memcpy(rc, rg->corner, sizeof rc);
+            rshift = rg->shift;
         }
         double t = INFINITY, grad[3]; /* (set when st is EXACT_FAST_ROOT) */
         int st = EXACT_FAST_UNDECIDED;
@@ -464,8 +471,8 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
                                      &have, &t, grad);
                 w->have = (w->have & ~bit) | (uint32_t)have << j;
                 w->model_key[j] = key;
-                if (st == EXACT_FAST_NONE && have && key == 0 && k1 - k0 == 1)
-                    st = root_beyond(w, r, v, t_exact, a, b, curv, &t, grad);
+                if (st == EXACT_FAST_NONE && have && k1 - k0 == 1)
+                    st = root_beyond(w, r, rc, rshift, key, t_exact, a, b, curv, &t, grad);
             }
         }
         if (st == EXACT_FAST_UNDECIDED) {

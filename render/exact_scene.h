@@ -93,7 +93,8 @@ typedef struct exact_worker {
      * differs from `key` (the models start afresh at the next voxel). */
     double ray_od[6];
     exact_line line;
-    double exit_t; /* where the line leaves the key's cell (NaN: not made) */
+    double exit_t;     /* where the line leaves region exit_key (NaN: not made) */
+    uint64_t exit_key;
     double widen;
     int line_new;
     /* per candidate of the scene, made on first use: its cell's a-priori
