@@ -241,22 +241,31 @@ static int fresh(const tape *t, exact_scratch *w, const exact_line *l, double a,
 }
 
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                    double curv, const exact_bound *cb, exact_model *model, int *have,
-                    double *root, double grad[3])
+                    double curv, const exact_bound *cb, double m_new, exact_model *model,
+                    int *have, double *root, double grad[3])
 {
     if (!(curv < INFINITY))
         return EXACT_FAST_UNDECIDED;
+    const double mid = 0.5 * (a + b);
+    if (!*have && m_new == m_new && m_new != mid) {
+        /* the caller's point first; undecided there: the span's midpoint */
+        const int st = fresh(t, w, l, a, b, curv, cb, m_new, 0, model, have, root, grad);
+        if (st != EXACT_FAST_UNDECIDED)
+            return st;
+        *have = 0;
+    }
     if (*have) {
         const int st = exact_fast_decide(t, w, l, a, b, curv, model, root, grad);
         if (st != EXACT_FAST_UNDECIDED)
             return st;
-        if (model->m >= a && model->m <= b) {
-            /* a model of this span would be the same, but for its bound */
+        if (fabs(model->m - mid) <= 0.25 * (b - a)) {
+            /* a model of this span (at its midpoint) would be about the
+             * same, but for its bound */
             if (!model->cb || !worth_retry(model, a, b, curv))
                 return EXACT_FAST_UNDECIDED;
             w->nretry++;
             return fresh(t, w, l, a, b, curv, NULL, model->m, 1, model, have, root, grad);
         }
     }
-    return fresh(t, w, l, a, b, curv, cb, 0.5 * (a + b), 0, model, have, root, grad);
+    return fresh(t, w, l, a, b, curv, cb, mid, 0, model, have, root, grad);
 }

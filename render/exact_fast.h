@@ -79,7 +79,7 @@ int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, doub
  * the whole cell along the line that it can, for the cost of about one such
  * interval.) */
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                    double curv, const exact_bound *cb, exact_model *model, int *have,
-                    double *root, double grad[3]);
+                    double curv, const exact_bound *cb, double m_new, exact_model *model,
+                    int *have, double *root, double grad[3]);
 
 #endif

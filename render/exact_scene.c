@@ -8,6 +8,7 @@
 
 #include "common/expr/tape_hess.h"
 #include "render/exact_fast.h"
+#include "render/trace_impl.h"
 
 /* Growable pools while building; pointers are set once they stop moving. */
 typedef struct builder {
@@ -390,6 +391,20 @@ static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t c[3],
     return EXACT_FAST_ROOT;
 }
 
+/* Where the ray meets voxel n's stored plane (the paper's hit), clamped
+ * into [a, e]: a first model there starts next to the root, so that one
+ * Newton step less places it. NaN without records or plane crossing. */
+static double plane_hint(const oct_tree *tree, const trace_ray *r, uint64_t n,
+                         const uint32_t v[3], double a, double e)
+{
+    if (!tree->voxels)
+        return NAN;
+    double num, den;
+    trace_voxel_plane(tree, r, n, v, &num, &den);
+    const double tp = num / den;
+    return tp > a ? (tp < e ? tp : e) : tp == tp ? a : NAN;
+}
+
 int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
                 double t_out, double *t_hit, trace_hit *hit)
 {
@@ -467,7 +482,14 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
                 int have = (w->have & bit) && w->model_key[j] == key;
                 const exact_bound *cb =
                     key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
-                st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, &w->model[j],
+                /* a first model at the stored plane's hit where it spares a
+                 * Newton step of a long tape (one with the a-priori bound) */
+                const double m_new =
+                    !have && cb && k1 - k0 == 1
+                        ? plane_hint(es->tree, r, hit->voxel, v, a,
+                                     region_exit(w, r, rc, rshift, key))
+                        : NAN;
+                st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, m_new, &w->model[j],
                                      &have, &t, grad);
                 w->have = (w->have & ~bit) | (uint32_t)have << j;
                 w->model_key[j] = key;

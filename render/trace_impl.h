@@ -12,6 +12,7 @@
 
 #include <stdint.h>
 
+#include "format/oct_normal.h"
 #include "render/trace.h"
 
 #if defined(__SSE4_1__)
@@ -96,6 +97,23 @@ trace_occluded_fn trace_occluded_for(trace_traverse_fn fn);
 /* trace_setup_eye without its shortcut for an eye inside the root cube:
  * the tests compare the two. */
 int trace_setup_eye_general(const trace_eye *e, const double dir[3], trace_ray *r);
+
+/* Voxel idx's stored plane along the ray (corner v): s(t) = t * den - num
+ * is the signed distance, in voxel edges, of p(t) from the plane. */
+static inline void trace_voxel_plane(const oct_tree *tree, const trace_ray *r, uint64_t idx,
+                                     const uint32_t v[3], double *num, double *den)
+{
+    const uint32_t rec = tree->voxels[idx];
+    float nf[3];
+    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, nf);
+    double nu = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT)), de = 0.0;
+    for (int a = 0; a < 3; a++) {
+        nu -= (double)nf[a] * (r->o[a] - ((double)v[a] + 0.5));
+        de += (double)nf[a] * r->d[a];
+    }
+    *num = nu;
+    *den = de;
+}
 
 /* --refine in one occupied voxel (render/trace_refine.c). */
 int trace_refine_voxel(const oct_tree *tree, const trace_ray *r, uint64_t idx, const uint32_t v[3],

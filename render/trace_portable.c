@@ -180,6 +180,7 @@ int trace_traverse_portable(const oct_tree *tree, const trace_opts *opts, const 
                 double t_hit = tc;
                 if (opts->exact) {
                     const double te = min3(w.t);
+                    hit->voxel = n; /* (exact_voxel reads it) */
                     hit->hit = exact_voxel(opts->exact, r, w.v, tc, te < t_end ? te : t_end,
                                            &t_hit, hit);
                 } else if (!opts->refine) {

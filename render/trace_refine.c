@@ -19,14 +19,8 @@
 int trace_refine_voxel(const oct_tree *tree, const trace_ray *r, uint64_t idx,
                        const uint32_t v[3], double t_in, double t_out, int *side, double *t_hit)
 {
-    const uint32_t rec = tree->voxels[idx];
-    float nf[3];
-    oct_normal_decode(rec & OCT_VOXEL_NORMAL_MASK, nf);
-    double num = oct_offset_decode((int8_t)(uint8_t)(rec >> OCT_VOXEL_OFFSET_SHIFT)), den = 0.0;
-    for (int a = 0; a < 3; a++) {
-        num -= (double)nf[a] * (r->o[a] - ((double)v[a] + 0.5));
-        den += (double)nf[a] * r->d[a];
-    }
+    double num, den;
+    trace_voxel_plane(tree, r, idx, v, &num, &den);
     /* s(t) = t * den - num */
     const double s_in = t_in * den - num, s_out = t_out * den - num;
     if (*side == 0)

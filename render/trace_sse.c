@@ -85,6 +85,7 @@ SSE_INLINE int voxel_hit(const oct_tree *tree, const trace_ray *r, const trace_o
         const double t_out = te < r->t_end ? te : r->t_end;
         uint32_t v[4];
         _mm_storeu_si128((__m128i *)v, V);
+        hit->voxel = n; /* (exact_voxel reads it) */
         if (opts->exact ? !exact_voxel(opts->exact, r, v, tc, t_out, &t, hit)
                         : !trace_refine_voxel(tree, r, n, v, tc, t_out, side, &t))
             return 0;
