@@ -351,14 +351,12 @@ static __attribute__((noinline)) void finish_hit(exact_worker *w, const tape *t,
 /* Local t where the ray leaves the region whose corner, in cells of
  * 2^shift voxels, is c (or the ray's end), made once a line and region
  * (exit_key; the key's reset clears it). */
-static double region_exit(exact_worker *w, const trace_ray *r, const uint32_t c[3],
-                          unsigned shift, uint64_t key)
+static inline double region_exit(exact_worker *w, const trace_ray *r, const uint32_t c[3],
+                                 unsigned shift, uint64_t key)
 {
     if (w->exit_t != w->exit_t || w->exit_key != key) {
         double te = r->t_end;
-        for (int a = 0; a < 3; a++) {
-            if (!(r->active >> a & 1u))
-                continue;
+        for (int a = 0; a < 3; a++) { /* (+inf on a zero axis) */
             const uint64_t k = (uint64_t)c[a] + (r->sgn[a] > 0);
             const double ta = trace_plane_time(r, a, (double)(k << shift));
             te = ta < te ? ta : te;
