@@ -1,7 +1,8 @@
 #!/bin/sh
 # render --exact end to end: on the command line and in views lines, with
 # the beam and without (same image), on a full and a shell-only file (same
-# image: only the function places the hits); a 1.0 file (no stored
+# image: only the function places the hits, and these tapes are too short
+# for a model to start at a stored plane, RENDER.md); a 1.0 file (no stored
 # function) is refused with the contract's message and writes nothing.
 set -u
 . "$ROOT/tests/cli/lib.sh"
