@@ -3,24 +3,33 @@
 #include "render/exact_hit.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #define MAX_DEPTH 60 /* halvings of one segment: 2^-60 of a voxel is below the resolution */
+
+void *exact_line_alloc(size_t n, size_t size)
+{
+    if (size && n > (SIZE_MAX - 63) / size)
+        return NULL;
+    const size_t bytes = n * size;
+    return aligned_alloc(64, bytes ? (bytes + 63) & ~(size_t)63 : 64);
+}
 
 int exact_scratch_init(exact_scratch *w, uint32_t n)
 {
     if (n < 1)
         n = 1;
     w->n = n;
-    w->slots = malloc(n * sizeof *w->slots);
-    w->islots = malloc(n * sizeof *w->islots);
-    w->gslots = malloc(n * sizeof *w->gslots);
-    w->dslots = malloc(n * sizeof *w->dslots);
-    w->idir = malloc(n * sizeof *w->idir);
-    w->dir = malloc(n * sizeof *w->dir);
-    w->dirg = malloc(n * sizeof *w->dirg);
-    w->edir = malloc(n * sizeof *w->edir);
-    w->cerr = malloc(n * sizeof *w->cerr);
+    w->slots = exact_line_alloc(n, sizeof *w->slots);
+    w->islots = exact_line_alloc(n, sizeof *w->islots);
+    w->gslots = exact_line_alloc(n, sizeof *w->gslots);
+    w->dslots = exact_line_alloc(n, sizeof *w->dslots);
+    w->idir = exact_line_alloc(n, sizeof *w->idir);
+    w->dir = exact_line_alloc(n, sizeof *w->dir);
+    w->dirg = exact_line_alloc(n, sizeof *w->dirg);
+    w->edir = exact_line_alloc(n, sizeof *w->edir);
+    w->cerr = exact_line_alloc(n, sizeof *w->cerr);
     w->nbound = w->nretry = w->nrescue = 0;
     if (!w->slots || !w->islots || !w->gslots || !w->dslots || !w->idir || !w->dir || !w->dirg ||
         !w->edir || !w->cerr) {

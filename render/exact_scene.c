@@ -263,8 +263,10 @@ int exact_worker_init(exact_worker *w, const exact_scene *es)
     w->fast = w->slow = w->beyond = 0;
     w->bound_min_n = EXACT_BOUND_MIN_N;
     exact_worker_new_frame(w);
-    w->bound = malloc((es->ncand ? es->ncand : 1) * sizeof *w->bound);
-    w->bound_state = calloc(es->ncand ? es->ncand : 1, 1);
+    w->bound = exact_line_alloc(es->ncand ? es->ncand : 1, sizeof *w->bound);
+    w->bound_state = exact_line_alloc(es->ncand ? es->ncand : 1, 1);
+    if (w->bound_state)
+        memset(w->bound_state, 0, es->ncand ? es->ncand : 1);
     if (!w->bound || !w->bound_state || exact_scratch_init(&w->scratch, es->max_n)) {
         free(w->bound);
         free(w->bound_state);

@@ -69,7 +69,7 @@ void exact_scene_box(const exact_scene *es, unsigned d, const uint32_t c[3], int
 
 /* A thread's state for the exact test: the scene and scratch for its tapes. */
 typedef struct exact_worker {
-    const exact_scene *scene;
+    _Alignas(64) const exact_scene *scene; /* (a cache line of its own: threads write theirs) */
     exact_scratch scratch;
     exact_sub_cache sub; /* its own sub-cells */
     uint64_t fast, slow; /* statistics: candidate tests the fast path decided, and not */

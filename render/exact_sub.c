@@ -29,11 +29,11 @@ int exact_sub_init(exact_sub_cache *c, uint32_t ncand, uint32_t max_n)
     c->ncand = ncand;
     c->max_nodes = EXACT_SUB_NODES;
     c->chunk_size = max_n > CHUNK_INSNS ? max_n : CHUNK_INSNS;
-    c->top = malloc(((size_t)ncand + 1) * sizeof *c->top);
-    c->islots = malloc(max_n * sizeof *c->islots);
-    c->hslots = malloc(max_n * sizeof *c->hslots);
-    c->tmp_insn = malloc(max_n * sizeof *c->tmp_insn);
-    c->tmp_mark = malloc(max_n * sizeof *c->tmp_mark);
+    c->top = exact_line_alloc((size_t)ncand + 1, sizeof *c->top);
+    c->islots = exact_line_alloc(max_n, sizeof *c->islots);
+    c->hslots = exact_line_alloc(max_n, sizeof *c->hslots);
+    c->tmp_insn = exact_line_alloc(max_n, sizeof *c->tmp_insn);
+    c->tmp_mark = exact_line_alloc(max_n, sizeof *c->tmp_mark);
     if (!c->top || !c->islots || !c->hslots || !c->tmp_insn || !c->tmp_mark) {
         exact_sub_free(c);
         return -1;

@@ -480,7 +480,9 @@ static int exact_workers(frame_keep *k, const frame_job *job, exact_worker **out
         return 0;
     }
     exact_workers_free(k);
-    k->exact = calloc(n, sizeof *k->exact);
+    k->exact = exact_line_alloc(n, sizeof *k->exact);
+    if (k->exact)
+        memset(k->exact, 0, n * sizeof *k->exact);
     while (k->exact && k->exact_n < n && exact_worker_init(&k->exact[k->exact_n], job->exact) == 0)
         k->exact_n++;
     if (!k->exact || k->exact_n < n) {
