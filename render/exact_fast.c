@@ -218,9 +218,10 @@ static int worth_retry(const exact_model *model, double a, double b, double K)
 /* A new model at m: from cb's bound first, and where that gives none or
  * does not decide (and a per-point bound might: worth_retry), from the
  * per-point one; `retry`: this is such a second try already. */
-static inline __attribute__((always_inline)) int fresh(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
-                 double curv, const exact_bound *cb, double m, int retry, exact_model *model,
-                 int *have, double *root, double grad[3])
+static inline __attribute__((always_inline)) int
+fresh(const tape *t, exact_scratch *w, const exact_line *l, double a, double b, double curv,
+      const exact_bound *cb, double m, int retry, exact_model *model, int *have, double *root,
+      double grad[3])
 {
     if (cb) {
         *have = exact_fast_model(t, w, l, m, cb, model);

@@ -72,9 +72,12 @@ int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, doub
 
 /* exact_fast_decide with the caller's model (*have: it holds one, for this
  * line and a box as above) if that decides; else, unless the model's m is
- * in [a, b] already, with a new model at the midpoint (*model and *have
- * updated), from cb's bound (may be NULL) and, if that does not decide,
- * from the per-point one. EXACT_FAST_UNDECIDED when curv is +inf. (No
+ * within a quarter span of the span's midpoint already, with a new model
+ * (*model and *have updated) at m_new when the caller had none and m_new
+ * is not NaN (a point of the line in the box), and where that does not
+ * decide, at the midpoint; each from cb's bound (may be NULL) and, if that
+ * does not decide, from the per-point one. EXACT_FAST_UNDECIDED when curv
+ * is +inf. (No
  * interval of f over the segment first: one model decides the voxels of
  * the whole cell along the line that it can, for the cost of about one such
  * interval.) */

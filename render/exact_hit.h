@@ -38,9 +38,9 @@ typedef struct exact_scratch {
 
 /* n elements of `size` bytes in cache lines of their own (64-byte aligned,
  * the size rounded up): each thread's worker writes its arrays all the
- * time, and two threads' arrays sharing a line cost both of them (the
- * threads' --exact frames took 10 % more CPU time than one thread's).
- * free() releases it; NULL when out of memory or on overflow. */
+ * time, and two threads' arrays sharing a line slow both (docs/perf-log.md,
+ * "the threads' workers in cache lines of their own"). free() releases it;
+ * NULL when out of memory or on overflow. */
 void *exact_line_alloc(size_t n, size_t size);
 
 /* Allocates scratch for tapes of up to n instructions: 0, or -1 when out

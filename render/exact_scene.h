@@ -116,9 +116,13 @@ void exact_worker_new_frame(exact_worker *w);
  * present in v's coarse cell on that span, widened by 2^-16 of a voxel each
  * way (so that a root the rasterizer's and this test's roundings put on
  * different sides of a voxel face is not lost; any root found is a root of
- * f, and nearer ones would lie in voxels already tested). Returns 1 on a
- * hit, with its local t in *t_hit and hit's exact (1), surface and unit
- * normal (facing the viewer) filled; the caller sets the rest. */
+ * f, and nearer ones would lie in voxels already tested); where v's cell has
+ * one surface, the first root past the span, up to where the ray leaves the
+ * cell, when the span's model certifies it (RENDER.md, "The root past the
+ * voxel"). hit->voxel holds v's index in the tree on entry (its stored
+ * plane places the first model). Returns 1 on a hit, with its local t in
+ * *t_hit and hit's exact (1), surface and unit normal (facing the viewer)
+ * filled; the caller sets the rest. */
 int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double t_in,
                 double t_out, double *t_hit, trace_hit *hit);
 
