@@ -1,6 +1,7 @@
 /* Tests for render/exact_hit: the first root along a segment against
  * analytic roots (sphere, plane, torus), tangency, functions undefined on
- * part of the segment (sqrt of a negative, log 0, a pole), and the normal. */
+ * part of the segment (sqrt of a negative, log 0, a pole), the normal, and
+ * the workers' cache-line allocations. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -171,12 +172,40 @@ static void test_normal(void **state)
     unload(&f);
 }
 
+/* exact_line_alloc: 64-byte aligned, whole lines usable (the sanitizer
+ * build would catch a write past the block), and NULL, not a wrapped size,
+ * on overflow. Two blocks never share a line. */
+static void test_line_alloc(void **state)
+{
+    (void)state;
+    static const size_t sizes[][2] = {{0, 8}, {1, 1}, {3, 16}, {5, 24}, {64, 1}, {100, 40}};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        unsigned char *a = exact_line_alloc(sizes[k][0], sizes[k][1]);
+        unsigned char *b = exact_line_alloc(sizes[k][0], sizes[k][1]);
+        assert_non_null(a);
+        assert_non_null(b);
+        assert_int_equal((uintptr_t)a % 64, 0);
+        assert_int_equal((uintptr_t)b % 64, 0);
+        const size_t bytes = sizes[k][0] * sizes[k][1];
+        const size_t lines = bytes ? (bytes + 63) / 64 * 64 : 64;
+        memset(a, 0xa5, lines);
+        memset(b, 0x5a, lines);
+        /* (disjoint whole lines: b's writes left a's alone) */
+        for (size_t i = 0; i < lines; i++)
+            assert_int_equal(a[i], 0xa5);
+        free(a);
+        free(b);
+    }
+    assert_null(exact_line_alloc(SIZE_MAX / 8, 16));
+    assert_null(exact_line_alloc(SIZE_MAX, 1));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere),       cmocka_unit_test(test_plane_and_torus),
         cmocka_unit_test(test_tangency),     cmocka_unit_test(test_undefined),
-        cmocka_unit_test(test_normal),
+        cmocka_unit_test(test_normal),       cmocka_unit_test(test_line_alloc),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
