@@ -1,6 +1,6 @@
 /* Tests for common/expr/tape on random expression trees and for the
  * pruner: interval enclosures of random trees and agreement of their
- * pruned tapes, tape_prune on a known min/max, tape_prune_const's
+ * pruned tapes, tape_prune on a known min/max and abs, tape_prune_const's
  * soundness and what it drops, tape_prune_kinks against tape_hess_kinks of
  * the pruned tape. */
 #include <setjmp.h>
@@ -231,11 +231,55 @@ static void test_prune(void **state)
     scene_free(s);
 }
 
+/* An abs whose operand is clear of 0 over the box goes: abs(x - 2) becomes
+ * -(x - 2), abs(y + 2) becomes y + 2, with the full tape's bits for f and
+ * its gradient at points of the box; one whose operand straddles 0 stays,
+ * and so does one whose operand touches 0 (abs(-0) is +0, not -0). */
+static void test_prune_abs(void **state)
+{
+    (void)state;
+    static const char text[] =
+        "bounds 0 0 0 1 1 1\nsurface abs(x - 2) * 3 + abs(y + 2) + abs(z - 0.5) + abs(x*y)\n";
+    scene *s = NULL;
+    scene_error e;
+    assert_int_equal(scene_parse(text, sizeof text - 1, &s, &e), 0);
+    const tape *t = &s->surfaces[0].tape;
+    interval slots[64], box[3] = {{0.25, 1}, {0, 1}, {0, 1}};
+    tape_insn out[64];
+    uint32_t scratch[64];
+    unsigned f;
+    tape_eval_interval(t, box, slots, &f);
+    assert_int_equal(f, 0);
+    tape pt;
+    uint32_t n = tape_prune(t, slots, f, out, scratch, &pt);
+    unsigned abs_left = 0, neg = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        abs_left += pt.insn[i].op == TAPE_ABS;
+        neg += pt.insn[i].op == TAPE_NEG;
+    }
+    /* abs(z - 0.5) straddles 0 and x*y touches it at y = 0: two stay. */
+    assert_int_equal(abs_left, 2);
+    assert_int_equal(neg, 1);
+    assert_int_equal(n, t->n - 1); /* abs(y + 2) gone, abs(x - 2) now a negation */
+    assert_int_equal(tape_prune_kinks(t, slots, scratch, &pt), TAPE_KINK_ABS);
+    double d1[64], d2[64];
+    tape_dual u1[64], u2[64];
+    for (int i = 0; i <= 16; i++) {
+        double p[3] = {0.25 + 0.75 * i / 16.0, i / 16.0, 1.0 - i / 16.0};
+        double g1[3], g2[3];
+        double v1 = tape_eval_grad(t, p, g1, u1), v2 = tape_eval_grad(&pt, p, g2, u2);
+        assert_true(v1 == v2 && tape_eval(t, p[0], p[1], p[2], d1) == tape_eval(&pt, p[0], p[1], p[2], d2));
+        assert_memory_equal(g1, g2, sizeof g1);
+    }
+    scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_random_trees),
         cmocka_unit_test(test_prune),
+        cmocka_unit_test(test_prune_abs),
         cmocka_unit_test(test_prune_const_stays_sound),
         cmocka_unit_test(test_prune_const_drops_far_terms),
         cmocka_unit_test(test_prune_kinks),

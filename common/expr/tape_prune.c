@@ -9,11 +9,20 @@
 
 /* Marks in m the instructions the value of `root` depends on: m[i] = i when
  * live, EMPTY when dead, w when instruction i is replaced by instruction w (a
- * decided min/max), CONSTANT when it is replaced by its enclosure s[i] (an
- * interval narrower than `tiny`: see tape_prune_const). s may be NULL: then
- * only dead code goes. Returns how many instructions stay as they are (n:
- * the tape is unchanged). */
+ * decided min/max, or an abs whose operand is positive), NEGATE when it
+ * becomes the negation of its operand (an abs whose operand is negative),
+ * CONSTANT when it is replaced by its enclosure s[i] (an interval narrower
+ * than `tiny`: see tape_prune_const). s may be NULL: then only dead code
+ * goes. Returns how many instructions stay as they are (n: the tape is
+ * unchanged).
+ *
+ * The decisions give the full tape's bits at every point of the box: a
+ * point's computed operands lie in their enclosures (each operation's
+ * rounded result stays between its enclosure's ends, which are doubles), so
+ * a min/max whose operands' enclosures are apart picks the same operand,
+ * and |a| is a or -a, exactly, when a's enclosure is clear of 0. */
 #define CONSTANT (EMPTY - 1)
+#define NEGATE (EMPTY - 2)
 static uint32_t mark(const tape_insn *in, uint32_t n, uint32_t root, const interval *s, double tiny,
                  uint32_t *m)
 {
@@ -31,6 +40,13 @@ static uint32_t mark(const tape_insn *in, uint32_t n, uint32_t root, const inter
         }
         if (s && i != root && s[i].hi - s[i].lo <= tiny) { /* NaN or inf: the test fails */
             m[i] = CONSTANT;
+            continue;
+        }
+        if (s && op == TAPE_ABS && (s[a].lo > 0.0 || s[a].hi < 0.0)) {
+            /* Strict, as below: abs(-0) is +0. */
+            m[i] = s[a].lo > 0.0 ? a : NEGATE;
+            if (m[a] == EMPTY)
+                m[a] = a;
             continue;
         }
         if (s && (op == TAPE_MIN || op == TAPE_MAX)) {
@@ -77,6 +93,12 @@ static uint32_t compact(const tape_insn *in, uint32_t n, uint32_t kept, uint32_t
             out[k].op = TAPE_CONST;
             out[k].a = (*nconst)++;
             out[k].b = 0;
+            m[i] = k++;
+            continue;
+        }
+        if (m[i] == NEGATE) {
+            tape_insn t = {.op = TAPE_NEG, .a = m[in[i].a], .b = 0};
+            out[k] = t;
             m[i] = k++;
             continue;
         }
