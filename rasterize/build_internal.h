@@ -133,6 +133,8 @@ typedef struct worker {
     tape_idual_lanes *iglslots; /* the lane interval gradient evaluator's */
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
+    tape *rec;             /* [nsurf]: the tapes the records evaluate (record_tapes) */
+    tape_insn *rec_insn;   /* [tape_total]: their instructions */
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
     tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
     uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
@@ -168,6 +170,13 @@ typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
  * box. Returns how many surfaces may cross it. */
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
                              interval box[3], double centre[3]);
+
+/* The tapes the records of the voxels under the node (lists at index idx,
+ * box) evaluate, into wk->rec: each surface's full tape with the min, max
+ * and abs that its enclosures over the box decide pruned away, and nothing
+ * else (tape_prune), so f and its gradient at any point of the box keep the
+ * full tape's bits. */
+void record_tapes(worker *wk, unsigned idx, const interval box[3]);
 
 /* A cell to test: its box, its centre, f at the centre in double (for the
  * centred form). */
@@ -239,7 +248,7 @@ static inline const double *centre_fg(worker *wk, unsigned s, const double centr
 {
     double *fg = wk->cf + 4 * (size_t)s;
     if (!wk->cf_ok[s]) {
-        fg[0] = tape_eval_grad(wk->c->full[s], centre, fg + 1, wk->dslots);
+        fg[0] = tape_eval_grad(&wk->rec[s], centre, fg + 1, wk->dslots);
         wk->st.point_evals++;
         wk->cf_ok[s] = 1;
     }

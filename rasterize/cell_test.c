@@ -307,6 +307,21 @@ unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const ui
     return n;
 }
 
+void record_tapes(worker *wk, unsigned idx, const interval box[3])
+{
+    const build_ctx *c = wk->c;
+    const unsigned ns = c->nsurf;
+    for (unsigned k = 0; k < wk->nact[idx]; k++) {
+        unsigned s = wk->act[(size_t)idx * ns + k], flags;
+        if (!wk->kinked[s]) /* index 0: the full tape has no min, max or abs */
+            continue;
+        tape_eval_interval(c->full[s], box, wk->slots, &flags);
+        wk->st.interval_evals++;
+        tape_prune(c->full[s], wk->slots, flags, wk->rec_insn + c->tape_off[s], wk->scratch,
+                   &wk->rec[s]);
+    }
+}
+
 /* The enclosures fc + x-half + y-half + z-half of the eight children (half
  * the products of G with the offsets off), summed in that order; children
  * that share the first terms share their partial sums (2 + 4 + 8 additions

@@ -33,13 +33,13 @@ static void centre_values(worker *wk, const tape *t, unsigned n, const double *x
     tape_eval_grad_lanes(t, n, x, y, z, f, g, wk->lslots);
 }
 
-/* The tape for f at voxel centres: the full one, whose bits the records
- * take; with --shell-only and one surface, where f serves only the centred
- * re-test's skip (which only keeps voxels, its margin covering the pruned
- * constants), the node's pruned one. */
+/* The tape for f at voxel centres: the record tape (record_tapes), whose
+ * bits the records take; with --shell-only and one surface, where f serves
+ * only the centred re-test's skip (which only keeps voxels, its margin
+ * covering the pruned constants), the node's pruned one. */
 static const tape *centre_tape(const worker *wk, const tape *pruned, unsigned s)
 {
-    return wk->c->par->shell_only && wk->c->nsurf == 1 ? pruned : wk->c->full[s];
+    return wk->c->par->shell_only && wk->c->nsurf == 1 ? pruned : &wk->rec[s];
 }
 
 /* With --shell-only and one surface, f at a child's centre serves only the
@@ -501,6 +501,11 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     uint8_t ok[OCT_MAX_SURFACES], fx[OCT_MAX_SURFACES]; /* fx: children the form drops */
     cell_box(c, depth, cell, pbox, pc);
     memcpy(wk->ncen[pidx], pc, sizeof pc);
+    /* The first mean-value node of its task's subtree: the records below
+     * it evaluate the tapes made for its box. */
+    if ((depth == c->task_depth || depth + MEAN_VALUE_LEVELS == c->levels) &&
+        !(c->par->shell_only && ns == 1))
+        record_tapes(wk, pidx, pbox);
     /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
      * holds its own, one evaluation fewer for a slightly wider form. */
     int reuse = depth + 1 == c->levels; /* its parent ran here too: MEAN_VALUE_LEVELS >= 2 */

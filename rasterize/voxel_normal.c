@@ -153,7 +153,7 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
         return push_voxel(wk, 0, shell_surface(wk, idx, centre));
     newton nw;
     unsigned best = voxel_surface(wk, idx, centre, &nw);
-    const tape *t = c->full[best];
+    const tape *t = &wk->rec[best];
     double h = c->cell_edge[c->levels];
     while (newton_advance(&nw, box, h)) {
         nw.f = tape_eval_grad(t, nw.p, nw.g, wk->dslots);
@@ -344,7 +344,7 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
                 lv[n++] = 1;
                 live[j] = 0;
             }
-        newton_rounds(wk, c->full[s], w, box, lv, n, h);
+        newton_rounds(wk, &wk->rec[s], w, box, lv, n, h);
     }
     for (unsigned j = 0; j < np && !wk->failed; j++)
         push_voxel(wk, newton_record(wk, &nw[j], cb->centre[child[j]], h), surf[j]);
@@ -411,7 +411,7 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
         }
     }
     if (any)
-        newton_rounds(wk, c->full[0], w, box, live, n, h);
+        newton_rounds(wk, &wk->rec[0], w, box, live, n, h);
     uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
     for (unsigned j = 0; j < n; j++)
         rec[j] = newton_record(wk, &nw[j], centre[j], h);

@@ -13,6 +13,8 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->scratch = malloc(len * sizeof *wk->scratch);
     wk->prune = malloc(depths * c->tape_total * sizeof *wk->prune);
     wk->prune_konst = malloc(depths * c->konst_total * sizeof *wk->prune_konst);
+    wk->rec = calloc(c->nsurf, sizeof *wk->rec);
+    wk->rec_insn = malloc((c->tape_total ? c->tape_total : 1) * sizeof *wk->rec_insn);
     wk->tapes = calloc(depths * c->nsurf, sizeof *wk->tapes);
     wk->act = calloc(depths * c->nsurf, 1);
     wk->kinked = calloc(depths * c->nsurf, 1);
@@ -29,11 +31,12 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->ilslots = malloc(len * sizeof *wk->ilslots);
     wk->iglslots = malloc(len * sizeof *wk->iglslots);
     if (!wk->ilslots || !wk->iglslots || !wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
-        !wk->prune || !wk->prune_konst || !wk->tapes || !wk->act || !wk->kinked || !wk->nact || !wk->grad ||
+        !wk->prune || !wk->prune_konst || !wk->rec || !wk->rec_insn || !wk->tapes || !wk->act || !wk->kinked || !wk->nact || !wk->grad ||
         !wk->grad_ok || !wk->fcen || !wk->ncen || !wk->cf || !wk->cf_ok || !wk->cf8 || !wk->cf8_have)
         return -1;
     for (unsigned s = 0; s < c->nsurf; s++) { /* index 0: the full tapes, valid everywhere */
         wk->tapes[s] = *c->full[s];
+        wk->rec[s] = *c->full[s];
         wk->act[s] = (uint8_t)s;
         wk->kinked[s] = tape_has_kink(c->full[s]);
     }
@@ -44,7 +47,7 @@ int worker_init(worker *wk, const build_ctx *c)
 void worker_free(worker *wk)
 {
     free(wk->slots); free(wk->slots2); free(wk->islots); free(wk->dslots);
-    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->tapes); free(wk->act); free(wk->kinked);
+    free(wk->scratch); free(wk->prune); free(wk->prune_konst); free(wk->rec); free(wk->rec_insn); free(wk->tapes); free(wk->act); free(wk->kinked);
     free(wk->nact);
     free(wk->grad); free(wk->grad_ok); free(wk->fcen); free(wk->ncen);
     free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->cf8_have); free(wk->lslots);
