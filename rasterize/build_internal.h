@@ -240,10 +240,11 @@ typedef struct newton {
 } newton;
 
 /* f and its gradient at the voxel centre for surface s, into wk->cf.
- * Normals, plane offsets and the surface choice use the whole function, not
- * the cell's pruned tape: a term frozen into a constant kept f's value to a
- * thousandth of a voxel but lost its gradient, which skews the normals and
- * offsets (docs/perf-log.md, rasterize). */
+ * Normals, plane offsets and the surface choice take the whole function's
+ * bits (the record tape, record_tapes), not the cell's pruned tape: a term
+ * frozen into a constant kept f's value to a thousandth of a voxel but lost
+ * its gradient, which skews the normals and offsets (docs/perf-log.md,
+ * rasterize). */
 static inline const double *centre_fg(worker *wk, unsigned s, const double centre[3])
 {
     double *fg = wk->cf + 4 * (size_t)s;

@@ -64,17 +64,17 @@ static int newton_advance(newton *nw, const interval box[3], double h)
     return 1;
 }
 
-/* The voxel's record from where the iteration stopped. */
-static uint32_t newton_record(worker *wk, const newton *nw, const double centre[3], double h)
+/* The voxel's record from an iterate p with f and grad f there (f, g); the
+ * centre's values fg are the fallback where those fail. */
+static uint32_t record_at(worker *wk, const double p[3], double f, const double gi[3],
+                          const double fg[4], const double centre[3], double h)
 {
-    double p[3], g[3], f = nw->f;
-    memcpy(p, nw->p, sizeof p);
-    memcpy(g, nw->g, sizeof g);
+    const double *q = p, *g = gi;
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f)) { /* g2 finite: so is each g[k] */
-        memcpy(p, centre, sizeof p);
-        f = nw->fg[0];
-        memcpy(g, nw->fg + 1, sizeof g);
+        q = centre;
+        f = fg[0];
+        g = fg + 1;
         g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
         if (!(g2 > 0.0) || !isfinite(g2)) {
             wk->st.normal_fallbacks++;
@@ -87,7 +87,7 @@ static uint32_t newton_record(worker *wk, const newton *nw, const double centre[
     double len = sqrt(g2), n[3], d = 0.0;
     for (int k = 0; k < 3; k++) {
         n[k] = g[k] / len;
-        double s = p[k] - f / g2 * g[k]; /* surface point of the linearisation */
+        double s = q[k] - f / g2 * g[k]; /* surface point of the linearisation */
         d += n[k] * (s - centre[k]);
     }
     d /= h;
@@ -97,6 +97,11 @@ static uint32_t newton_record(worker *wk, const newton *nw, const double centre[
     return oct_voxel_pack(n, d);
 }
 
+/* The voxel's record from where the iteration stopped. */
+static uint32_t newton_record(worker *wk, const newton *nw, const double centre[3], double h)
+{
+    return record_at(wk, nw->p, nw->f, nw->g, nw->fg, centre, h);
+}
 
 unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw)
 {
@@ -266,6 +271,32 @@ static int newton_first(newton *nw, const interval box[3], const double centre[3
     return 0;
 }
 
+/* newton_start, newton_first with a Hessian H and newton_record in one, on
+ * the same arithmetic (the same record, bit for bit), without the iteration's
+ * state: the voxel (centre c, box, f and grad f at c in fg) of a leaf-parent
+ * whose H is known. */
+static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
+                             const interval box[3], double h, const double H[3][3])
+{
+    const double f0 = fg[0], *g0 = fg + 1;
+    double p[3] = {c[0], c[1], c[2]};
+    double g2 = g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2];
+    if (g2 > 0.0 && isfinite(g2) && isfinite(f0) && f0 != 0.0) /* newton_target's step */
+        for (int k = 0; k < 3; k++)
+            p[k] = min2(max2(c[k] - f0 / g2 * g0[k], box[k].lo), box[k].hi);
+    double d[3], Hd[3], f = f0, g[3]; /* model_at_iterate */
+    for (int k = 0; k < 3; k++)
+        d[k] = p[k] - c[k];
+    for (int r = 0; r < 3; r++) {
+        Hd[r] = H[r][0] * d[0] + H[r][1] * d[1] + H[r][2] * d[2];
+        f += g0[r] * d[r];
+    }
+    f += 0.5 * (d[0] * Hd[0] + d[1] * Hd[1] + d[2] * Hd[2]);
+    for (int r = 0; r < 3; r++)
+        g[r] = g0[r] + Hd[r];
+    return record_at(wk, p, f, g, fg, c, h);
+}
+
 #define ROUND_MAX 64 /* voxels of a leaf_batch: 8 leaf-parents of 8 */
 
 /* The Newton iterations w[j] (boxes box[j]) on tape t that still move
@@ -394,6 +425,8 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
         if (from >= 0)
             have_h[b] = 2 * leaf_hessian(D[b], axes[b], (const double (*)[3])H[from], H[b]);
     }
+    uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
+    uint8_t iterated[ROUND_MAX]; /* no Hessian: the record waits for the Newton rounds */
     for (unsigned b = 0; b < nb; b++) {
         const leaf_voxels *v = &lv[b];
         if (!v->keep)
@@ -402,19 +435,26 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
         for (unsigned i = 0; i < 8; i++) {
             if (!((v->keep >> i) & 1))
                 continue;
-            newton_start(&nw[n], v->cb->centre[i], v->cf8 + 4 * i);
             w[n] = &nw[n];
             box[n] = v->cb->box[i];
             centre[n] = v->cb->centre[i];
-            live[n] = (uint8_t)newton_first(&nw[n], box[n], centre[n], h, Hb);
+            iterated[n] = !Hb;
+            live[n] = 0;
+            if (Hb) {
+                rec[n] = model_record(wk, centre[n], v->cf8 + 4 * i, box[n], h, Hb);
+                n++;
+                continue;
+            }
+            newton_start(&nw[n], centre[n], v->cf8 + 4 * i);
+            live[n] = (uint8_t)newton_first(&nw[n], box[n], centre[n], h, NULL);
             any |= live[n++];
         }
     }
     if (any)
         newton_rounds(wk, &wk->rec[0], w, box, live, n, h);
-    uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
     for (unsigned j = 0; j < n; j++)
-        rec[j] = newton_record(wk, &nw[j], centre[j], h);
+        if (iterated[j])
+            rec[j] = newton_record(wk, &nw[j], centre[j], h);
     if (wk->failed || !n)
         return;
     if (buf_push(&wk->out->voxels, rec, n * sizeof *rec)) {
