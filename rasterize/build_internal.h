@@ -217,10 +217,12 @@ int child_enclosures(worker *wk, const tape *t, const interval pbox[3], unsigned
 
 /* A node's own mean-value form, as child_enclosures makes it without
  * reuse: G over its box, fc = f([c]) at its centre; ok 0 where either may
- * be undefined. */
+ * be undefined. kinked: the tape has a kink the enclosures over the node's
+ * box do not decide (tape_prune_kinks' rules; 1 where flagged). */
 typedef struct node_form {
     interval fc, G[3];
     int ok;
+    uint8_t kinked;
 } node_form;
 
 /* The forms of n <= TAPE_LANES nodes (boxes box, centres centre) on one
