@@ -138,7 +138,8 @@ typedef struct worker {
     tape_const *prune_konst; /* [(levels + 2) * konst_total] */
     tape *tapes;           /* [(levels + 2) * nsurf]: index depth+1 holds the cell's tapes */
     uint8_t *act;          /* [(levels + 2) * nsurf]: surfaces that may cross the cell */
-    uint8_t *kinked;       /* [(levels + 2) * nsurf]: the cell's tape of that surface has a kink */
+    uint8_t *kinked;       /* [(levels + 2) * nsurf]: the cell's tape of that surface has a kink
+                              not known to be decided over the cell (index 0: the full tape) */
     unsigned *nact;        /* [levels + 2] */
     interval *grad;        /* [(levels + 2) * nsurf * 3]: gradient enclosure over the cell */
     double *cf;            /* [nsurf * 4]: f and its gradient at the current voxel's centre */
@@ -228,8 +229,9 @@ typedef struct node_form {
 /* The forms of n <= TAPE_LANES nodes (boxes box, centres centre) on one
  * tape, their gradient enclosures in one pass of the lane interval gradient
  * evaluator, their centres' in one of the lane interval evaluator: the same
- * bits as child_enclosures makes node by node. */
-void node_forms(worker *wk, const tape *t, unsigned n, interval box[][3],
+ * bits as child_enclosures makes node by node. kinks: whether t may have an
+ * undecided kink at all (else every nf[j].kinked is 0). */
+void node_forms(worker *wk, const tape *t, int kinks, unsigned n, interval box[][3],
                 const double centre[][3], node_form *nf);
 
 /* --- voxels (voxel_normal.c) -------------------------------------------- */

@@ -185,14 +185,13 @@ static uint8_t slots_kinked(const tape *t, const tape_idual *sc, const tape_idua
     return 0;
 }
 
-void node_forms(worker *wk, const tape *t, unsigned n, interval box[][3],
+void node_forms(worker *wk, const tape *t, int kinks, unsigned n, interval box[][3],
                 const double centre[][3], node_form *nf)
 {
     interval pts[TAPE_LANES][3], out[TAPE_LANES];
     unsigned fl[TAPE_LANES], lane[TAPE_LANES], m = 0;
     interval v[TAPE_LANES];
     unsigned gf[TAPE_LANES];
-    const int kinks = wk->kinked[0]; /* the full tape has a kink: this one may */
     if (n == 1) { /* one alone: the scalar evaluator, the same bits */
         tape_eval_interval_grad(t, box[0], nf[0].G, wk->islots, &gf[0]);
         nf[0].kinked = kinks && (gf[0] || slots_kinked(t, wk->islots, NULL, 0));

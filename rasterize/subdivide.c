@@ -218,7 +218,8 @@ static uint8_t visit_siblings(worker *wk, unsigned depth, uint64_t cell[][3], co
     node_form nf[8];
     for (unsigned j = 0; j < n; j++)
         cell_box(c, depth, cell[j], box[j], centre[j]);
-    node_forms(wk, &wk->tapes[depth + 1], n, box, (const double(*)[3])centre, nf);
+    node_forms(wk, &wk->tapes[depth + 1], wk->kinked[depth], n, box, (const double(*)[3])centre,
+               nf);
     uint8_t mask = 0;
     for (unsigned j = 0; j < n && !wk->failed; j++) {
         wk->nact[depth + 1] = 1; /* a later sibling dropped may have cleared it */
