@@ -12,6 +12,7 @@
 #include <math.h>
 
 #include "common/expr/interval_lanes.h"
+#include "common/expr/tape_hess.h"
 #include "rasterize/build_internal.h"
 #include "rasterize/cell_geometry.h"
 
@@ -152,37 +153,18 @@ void centred_form_drops(worker *wk, const tape *t, const interval G[3], const re
     }
 }
 
-/* Slot i's value enclosure from the scalar interval gradient evaluator's
- * slots (sc), or from lane l of the lane evaluator's (sl). */
-static interval slot_enclosure(const tape_idual *sc, const tape_idual_lanes *sl, unsigned l,
-                               uint32_t i)
-{
-    if (sc)
-        return sc[i].v;
-    interval v = {sl[i].v.lo[l], sl[i].v.hi[l]};
-    return v;
-}
-
-/* Whether t has an abs or min/max that its slots' enclosures (as
- * slot_enclosure reads them) leave undecided: tape_prune_kinks' rules. */
-static uint8_t slots_kinked(const tape *t, const tape_idual *sc, const tape_idual_lanes *sl,
-                            unsigned l)
+/* Whether t has an abs or min/max that its slots' enclosures leave
+ * undecided (tape_prune_kinks), the enclosures read from the scalar interval
+ * gradient evaluator's slots (sc) or from lane l of the lane evaluator's
+ * (sl), through wk->slots. */
+static uint8_t slots_kinked(worker *wk, const tape *t, const tape_idual *sc,
+                            const tape_idual_lanes *sl, unsigned l)
 {
     for (uint32_t i = 0; i < t->n; i++) {
-        const tape_insn *in = &t->insn[i];
-        if (in->op != TAPE_ABS && in->op != TAPE_MIN && in->op != TAPE_MAX)
-            continue;
-        const interval a = slot_enclosure(sc, sl, l, in->a);
-        if (in->op == TAPE_ABS) {
-            if (!(a.lo >= 0.0 || a.hi <= 0.0))
-                return 1;
-        } else {
-            const interval c = slot_enclosure(sc, sl, l, in->b);
-            if (!(a.hi < c.lo || c.hi < a.lo))
-                return 1;
-        }
+        interval v = sc ? sc[i].v : (interval){sl[i].v.lo[l], sl[i].v.hi[l]};
+        wk->slots[i] = v;
     }
-    return 0;
+    return tape_prune_kinks(t, wk->slots, NULL, t) != 0;
 }
 
 void node_forms(worker *wk, const tape *t, int kinks, unsigned n, interval box[][3],
@@ -194,13 +176,13 @@ void node_forms(worker *wk, const tape *t, int kinks, unsigned n, interval box[]
     unsigned gf[TAPE_LANES];
     if (n == 1) { /* one alone: the scalar evaluator, the same bits */
         tape_eval_interval_grad(t, box[0], nf[0].G, wk->islots, &gf[0]);
-        nf[0].kinked = kinks && (gf[0] || slots_kinked(t, wk->islots, NULL, 0));
+        nf[0].kinked = kinks && (gf[0] || slots_kinked(wk, t, wk->islots, NULL, 0));
     } else {
         interval G[TAPE_LANES][3];
         tape_eval_interval_grad_lanes(t, n, (const interval(*)[3])box, v, G, gf, wk->iglslots);
         for (unsigned j = 0; j < n; j++) {
             memcpy(nf[j].G, G[j], sizeof G[j]);
-            nf[j].kinked = kinks && (gf[j] || slots_kinked(t, NULL, wk->iglslots, j));
+            nf[j].kinked = kinks && (gf[j] || slots_kinked(wk, t, NULL, wk->iglslots, j));
         }
     }
     wk->st.gradient_evals += n;
