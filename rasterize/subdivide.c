@@ -225,7 +225,7 @@ static uint8_t visit_siblings(worker *wk, unsigned depth, uint64_t cell[][3], co
         wk->nact[depth + 1] = 1; /* a later sibling dropped may have cleared it */
         /* a kink of the parent's tape may be decided over this node's box:
          * its leaf-parents then skip the plain re-test and take Hessians */
-        wk->kinked[depth + 1] = (uint8_t)(wk->kinked[depth] && nf[j].kinked);
+        wk->kinked[depth + 1] = nf[j].kinked;
         if (visit_node(wk, depth, cell[j], &nf[j]))
             mask |= (uint8_t)(1u << slot[j]);
     }

@@ -234,47 +234,12 @@ static int leaf_hessian(const double D[3][3], unsigned axes, const double (*B)[3
     return 1;
 }
 
-/* The second-order model about the centre c (f, grad f and H there) at the
- * iterate p of the first Newton step: f(p) and grad f(p) without evaluating
- * them. Over a voxel the model's error is third order in its size, below what
- * more Newton steps would correct (docs/perf-log.md, rasterize). */
-static void model_at_iterate(newton *nw, const double c[3], const double H[3][3])
-{
-    double d[3], Hd[3], f = nw->fg[0];
-    for (int k = 0; k < 3; k++)
-        d[k] = nw->p[k] - c[k];
-    for (int r = 0; r < 3; r++) {
-        Hd[r] = H[r][0] * d[0] + H[r][1] * d[1] + H[r][2] * d[2];
-        f += nw->fg[1 + r] * d[r];
-    }
-    f += 0.5 * (d[0] * Hd[0] + d[1] * Hd[1] + d[2] * Hd[2]);
-    nw->f = f;
-    for (int r = 0; r < 3; r++)
-        nw->g[r] = nw->fg[1 + r] + Hd[r];
-}
-
-/* A voxel's first step towards its record, its iteration started at the
- * centre: with a Hessian H of the leaf-parent (H not NULL), the first Newton
- * step however short, then the model there (no evaluation, nothing more to
- * do: 0); without, newton_advance (1 when an evaluation is wanted). */
-static int newton_first(newton *nw, const interval box[3], const double centre[3], double h,
-                        const double (*H)[3])
-{
-    if (!H)
-        return newton_advance(nw, box, h);
-    double q[3];
-    if (newton_target(nw, box, q) >= 0.0) {
-        memcpy(nw->p, q, sizeof q);
-        nw->step++;
-    }
-    model_at_iterate(nw, centre, H);
-    return 0;
-}
-
-/* newton_start, newton_first with a Hessian H and newton_record in one, on
- * the same arithmetic (the same record, bit for bit), without the iteration's
- * state: the voxel (centre c, box, f and grad f at c in fg) of a leaf-parent
- * whose H is known. */
+/* The record of a voxel (centre c, box, f and grad f at c in fg) of a
+ * leaf-parent whose Hessian H is known: the first Newton step from c however
+ * short (newton_target's), then f and grad f there from the second-order
+ * model about c, without evaluating them, and the record from those. Over a
+ * voxel the model's error is third order in its size, below what more
+ * Newton steps would correct (docs/perf-log.md, rasterize). */
 static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
                              const interval box[3], double h, const double H[3][3])
 {
@@ -284,7 +249,7 @@ static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
     if (g2 > 0.0 && isfinite(g2) && isfinite(f0) && f0 != 0.0) /* newton_target's step */
         for (int k = 0; k < 3; k++)
             p[k] = min2(max2(c[k] - f0 / g2 * g0[k], box[k].lo), box[k].hi);
-    double d[3], Hd[3], f = f0, g[3]; /* model_at_iterate */
+    double d[3], Hd[3], f = f0, g[3]; /* the model at p */
     for (int k = 0; k < 3; k++)
         d[k] = p[k] - c[k];
     for (int r = 0; r < 3; r++) {
@@ -350,6 +315,8 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
     }
     double H[3][3];
     int hs = -1, have_h = 0; /* the surface H was made for, and whether it could be */
+    uint32_t rec[8];
+    uint8_t modelled[8]; /* the record made from the model, no iteration */
     for (unsigned j = 0; j < np; j++) {
         if ((int)surf[j] != hs) {
             hs = surf[j];
@@ -357,8 +324,13 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
             have_h = leaf_columns(wk->cf8 + (size_t)surf[j] * 32, wk->cf8_have[surf[j]], cb, D) == 7 &&
                      leaf_hessian(D, 7, NULL, H);
         }
-        live[j] = (uint8_t)newton_first(&nw[j], cb->box[child[j]], cb->centre[child[j]], h,
-                                        have_h ? (const double (*)[3])H : NULL);
+        modelled[j] = (uint8_t)have_h;
+        live[j] = 0;
+        if (have_h)
+            rec[j] = model_record(wk, cb->centre[child[j]], nw[j].fg, cb->box[child[j]], h,
+                                  (const double (*)[3])H);
+        else
+            live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
     }
     for (unsigned j0 = 0; j0 < np; j0++) { /* surface by surface, those still moving */
         if (!live[j0])
@@ -378,7 +350,8 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
         newton_rounds(wk, &wk->rec[s], w, box, lv, n, h);
     }
     for (unsigned j = 0; j < np && !wk->failed; j++)
-        push_voxel(wk, newton_record(wk, &nw[j], cb->centre[child[j]], h), surf[j]);
+        push_voxel(wk, modelled[j] ? rec[j] : newton_record(wk, &nw[j], cb->centre[child[j]], h),
+                   surf[j]);
 }
 
 /* Squared distance between the centres of two leaf-parents. */
@@ -446,7 +419,7 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
                 continue;
             }
             newton_start(&nw[n], centre[n], v->cf8 + 4 * i);
-            live[n] = (uint8_t)newton_first(&nw[n], box[n], centre[n], h, NULL);
+            live[n] = (uint8_t)newton_advance(&nw[n], box[n], h);
             any |= live[n++];
         }
     }
