@@ -33,20 +33,17 @@ static void newton_start(newton *nw, const double centre[3], const double fg_cen
     nw->step = 0;
 }
 
-/* The Newton step from the iterate, kept inside the voxel, into q; how far
- * it moves (max norm). -1 when it cannot be taken. */
-static double newton_target(const newton *nw, const interval box[3], double q[3])
+/* The Newton step from p (f and grad f there: f, g), kept inside the voxel
+ * (box), into q; 0 when it cannot be taken (q untouched). */
+static int newton_step(const double p[3], double f, const double g[3], const interval box[3],
+                       double q[3])
 {
-    const double f = nw->f, *g = nw->g, *p = nw->p;
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
-        return -1.0;
-    double moved = 0.0;
-    for (int k = 0; k < 3; k++) {
+        return 0;
+    for (int k = 0; k < 3; k++)
         q[k] = min2(max2(p[k] - f / g2 * g[k], box[k].lo), box[k].hi); /* NaN gives lo */
-        moved = max2(moved, fabs(q[k] - p[k]));
-    }
-    return moved;
+    return 1;
 }
 
 /* With f and its gradient at the iterate known: 1 when the iterate moved
@@ -56,9 +53,13 @@ static int newton_advance(newton *nw, const interval box[3], double h)
     double q[3];
     if (nw->step == NEWTON_STEPS)
         return 0;
-    double moved = newton_target(nw, box, q);
+    if (!newton_step(nw->p, nw->f, nw->g, box, q))
+        return 0; /* no step */
+    double moved = 0.0; /* max norm */
+    for (int k = 0; k < 3; k++)
+        moved = max2(moved, fabs(q[k] - nw->p[k]));
     if (moved < NEWTON_TOL * h)
-        return 0; /* the linearisation at p places the surface well enough (or no step) */
+        return 0; /* the linearisation at p places the surface well enough */
     memcpy(nw->p, q, sizeof q);
     nw->step++;
     return 1;
@@ -236,7 +237,7 @@ static int leaf_hessian(const double D[3][3], unsigned axes, const double (*B)[3
 
 /* The record of a voxel (centre c, box, f and grad f at c in fg) of a
  * leaf-parent whose Hessian H is known: the first Newton step from c however
- * short (newton_target's), then f and grad f there from the second-order
+ * short (newton_step's), then f and grad f there from the second-order
  * model about c, without evaluating them, and the record from those. Over a
  * voxel the model's error is third order in its size, below what more
  * Newton steps would correct (docs/perf-log.md, rasterize). */
@@ -244,11 +245,9 @@ static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
                              const interval box[3], double h, const double H[3][3])
 {
     const double f0 = fg[0], *g0 = fg + 1;
-    double p[3] = {c[0], c[1], c[2]};
-    double g2 = g0[0] * g0[0] + g0[1] * g0[1] + g0[2] * g0[2];
-    if (g2 > 0.0 && isfinite(g2) && isfinite(f0) && f0 != 0.0) /* newton_target's step */
-        for (int k = 0; k < 3; k++)
-            p[k] = min2(max2(c[k] - f0 / g2 * g0[k], box[k].lo), box[k].hi);
+    double p[3];
+    if (!newton_step(c, f0, g0, box, p))
+        memcpy(p, c, sizeof p); /* no step: the model at c itself */
     double d[3], Hd[3], f = f0, g[3]; /* the model at p */
     for (int k = 0; k < 3; k++)
         d[k] = p[k] - c[k];
