@@ -3,104 +3,20 @@
 #include "format/oct.h"
 #include "format/oct_layout.h"
 #include "format/oct_sink.h"
+#include "format/oct_store.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <sys/mman.h>
 #include <zlib.h>
-
-/* Bytes kept in chunks of STORE_CHUNK bytes: appending never moves what is
- * stored. (A doubling realloc of hundreds of megabytes copies them on some
- * systems and on others moves their pages, which a virtual machine may then
- * fault in again one by one when they are next read: docs/perf-log.md.) */
-#define STORE_BITS 21
-#define STORE_CHUNK ((size_t)1 << STORE_BITS)
-typedef struct chunked {
-    unsigned char **c;
-    size_t nchunks, cap; /* chunks allocated, slots in c */
-    size_t n;            /* bytes stored */
-} chunked;
-
-/* Chunk k of a store. From the second on, one huge page: aligned to its
- * size with a huge-page hint, so filling it takes one page fault, not 512
- * (each some 15 us of CPU on a virtual machine). The first keeps small
- * pages, so a small store (the upper depths' masks) costs no more memory
- * than it fills. */
-static void *chunk_alloc(size_t k)
-{
-    if (k == 0)
-        return oct__realloc(NULL, STORE_CHUNK);
-    void *p = oct__aligned_alloc(STORE_CHUNK, STORE_CHUNK);
-#ifdef MADV_HUGEPAGE
-    if (p)
-        (void)madvise(p, STORE_CHUNK, MADV_HUGEPAGE); /* a hint: small pages are fine */
-#endif
-    return p;
-}
-
-/* Appends n bytes; -1 (nothing appended) when memory runs out. */
-static int chunked_append(chunked *a, const void *data, size_t n)
-{
-    if (n > SIZE_MAX - STORE_CHUNK - a->n)
-        return -1;
-    const size_t need = (a->n + n + STORE_CHUNK - 1) >> STORE_BITS;
-    if (need > a->cap) {
-        size_t cap = a->cap ? a->cap : 16;
-        while (cap < need)
-            cap *= 2;
-        unsigned char **c = oct__realloc(a->c, cap * sizeof *c);
-        if (!c)
-            return -1;
-        a->c = c;
-        a->cap = cap;
-    }
-    for (; a->nchunks < need; a->nchunks++) /* kept on failure: capacity */
-        if (!(a->c[a->nchunks] = chunk_alloc(a->nchunks)))
-            return -1;
-    const unsigned char *p = data;
-    while (n) {
-        const size_t off = a->n & (STORE_CHUNK - 1);
-        const size_t k = STORE_CHUNK - off < n ? STORE_CHUNK - off : n;
-        memcpy(a->c[a->n >> STORE_BITS] + off, p, k);
-        a->n += k;
-        p += k;
-        n -= k;
-    }
-    return 0;
-}
-
-static inline unsigned char chunked_at(const chunked *a, size_t i)
-{
-    return a->c[i >> STORE_BITS][i & (STORE_CHUNK - 1)];
-}
-
-/* The stored bytes into s, in order. */
-static int chunked_put(const chunked *a, oct_sink *s)
-{
-    for (size_t i = 0; i < a->n; i += STORE_CHUNK) {
-        const size_t k = a->n - i < STORE_CHUNK ? a->n - i : STORE_CHUNK;
-        if (oct_sink_put(s, a->c[i >> STORE_BITS], k) != 0)
-            return -1;
-    }
-    return 0;
-}
-
-static void chunked_free(chunked *a)
-{
-    for (size_t i = 0; i < a->nchunks; i++)
-        free(a->c[i]);
-    free(a->c);
-    memset(a, 0, sizeof *a);
-}
 
 struct oct_writer {
     oct_writer_params p;
     float palette[OCT_MAX_SURFACES * 3];
-    chunked masks[OCT_MAX_LEVELS]; /* a byte a node: its count is the depth's node count */
-    chunked voxels;    /* 4 bytes a voxel (little-endian host); none with OCT_FLAG_SHELL_ONLY */
-    chunked surfaces;  /* a byte a voxel, with more than one surface */
+    oct_chunks masks[OCT_MAX_LEVELS]; /* a byte a node: its count is the depth's node count */
+    oct_spool voxels;     /* 4 bytes a voxel (little-endian host); none with OCT_FLAG_SHELL_ONLY */
+    oct_chunks surfaces;  /* a byte a voxel, with more than one surface */
     size_t voxel_count;
     unsigned char *function; /* copy of the FUNCTION section, or NULL */
     int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
@@ -165,6 +81,8 @@ oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out)
         w->p.function = w->function;
     }
     w->v11 = p->flags || p->function || p->shard_count;
+    oct_spool_open(&w->voxels, (p->flags & OCT_FLAG_SHELL_ONLY) ? NULL : p->spool_dir);
+    w->p.spool_dir = NULL; /* (not kept: only the open needs it) */
     for (uint32_t i = 0; i < 3 * p->surface_count; i++)
         w->palette[i] = p->palette ? p->palette[i] : 0.8f;
     w->p.palette = w->palette;
@@ -180,7 +98,7 @@ oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks
         if (masks[i] == 0)
             return OCT_EUSAGE; /* only non-empty nodes are stored */
     }
-    return chunked_append(&w->masks[depth], masks, n) == 0 ? OCT_OK : OCT_ENOMEM;
+    return oct_chunks_append(&w->masks[depth], masks, n) == 0 ? OCT_OK : OCT_ENOMEM;
 }
 
 oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8_t *surfaces, size_t n)
@@ -199,9 +117,9 @@ oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8
     /* the surfaces first: when the voxels then fail, the surfaces appended
        are taken back, so that the next call retries from the same state */
     const size_t ns = w->surfaces.n;
-    if (w->p.surface_count > 1 && chunked_append(&w->surfaces, surfaces, n) != 0)
+    if (w->p.surface_count > 1 && oct_chunks_append(&w->surfaces, surfaces, n) != 0)
         return OCT_ENOMEM;
-    if (!shell && chunked_append(&w->voxels, voxels, n * sizeof *voxels) != 0) {
+    if (!shell && oct_spool_append(&w->voxels, voxels, n * sizeof *voxels) != 0) {
         w->surfaces.n = ns;
         return OCT_ENOMEM;
     }
@@ -217,7 +135,7 @@ static int put_nodes(const oct_writer *w, oct_sink *s)
     enum { CHUNK = 4096 };
     unsigned char buf[CHUNK * 16];
     for (uint32_t d = 0; d < w->p.levels; d++) {
-        const chunked *m = &w->masks[d];
+        const oct_chunks *m = &w->masks[d];
         uint64_t base = 0, n = m->n;
         size_t fill = 0;
         for (uint64_t g = 0; g < groups_of(n); g++) {
@@ -225,7 +143,7 @@ static int put_nodes(const oct_writer *w, oct_sink *s)
             wr_u64le(rec, base);
             for (unsigned k = 0; k < 8; k++) {
                 uint64_t i = 8 * g + k;
-                rec[8 + k] = i < n ? chunked_at(m, i) : 0;
+                rec[8 + k] = i < n ? oct_chunks_at(m, i) : 0;
                 base += oct_popcount64(rec[8 + k]);
             }
             if (++fill == CHUNK) {
@@ -261,9 +179,9 @@ static int put_section(const oct_writer *w, int k, oct_sink *s)
     case OCT_SEC_NODES:
         return put_nodes(w, s);
     case OCT_SEC_VOXELS: /* little-endian host; nothing with OCT_FLAG_SHELL_ONLY */
-        return chunked_put(&w->voxels, s);
+        return oct_spool_put(&w->voxels, s);
     case OCT_SEC_SURFACES:
-        return w->p.surface_count > 1 ? chunked_put(&w->surfaces, s) : 0;
+        return w->p.surface_count > 1 ? oct_chunks_put(&w->surfaces, s) : 0;
     case OCT_SEC_PALETTE:
         return oct_sink_put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
     default:
@@ -323,11 +241,11 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
     if (w->masks[0].n > 1)
         return OCT_EUSAGE;
     for (uint32_t d = 0; d < L; d++) {
-        const chunked *m = &w->masks[d];
+        const oct_chunks *m = &w->masks[d];
         uint64_t children = 0;
-        for (size_t i = 0; i < m->n; i += STORE_CHUNK) {
-            const unsigned char *c = m->c[i >> STORE_BITS];
-            for (size_t j = 0, k = m->n - i < STORE_CHUNK ? m->n - i : STORE_CHUNK; j < k; j++)
+        for (size_t i = 0; i < m->n; i += OCT_CHUNK) {
+            const unsigned char *c = m->c[i >> OCT_CHUNK_BITS];
+            for (size_t j = 0, k = m->n - i < OCT_CHUNK ? m->n - i : OCT_CHUNK; j < k; j++)
                 children += oct_popcount64(c[j]);
         }
         uint64_t want = d + 1 < L ? w->masks[d + 1].n : w->voxel_count;
@@ -350,7 +268,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             for (uint32_t d = 0; d < L; d++)
                 size += 16 * groups_of(w->masks[d].n);
             break;
-        case OCT_SEC_VOXELS: size = w->voxels.n; break;
+        case OCT_SEC_VOXELS: size = oct_spool_size(&w->voxels); break;
         case OCT_SEC_SURFACES: size = w->p.surface_count > 1 ? w->voxel_count : 0; break;
         case OCT_SEC_PALETTE: size = 12u * w->p.surface_count; break;
         default: size = w->function ? w->p.function_size : 0; break;
@@ -361,7 +279,9 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             end = lay.off[k] + size;
         }
         oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0, 0};
-        put_section(w, k, &crc);
+        errno = 0;
+        if (put_section(w, k, &crc) != 0) /* (only the spool's read-back can fail) */
+            return OCT_EIO;
         lay.crc[k] = (uint32_t)crc.crc;
     }
     lay.file_size = end;
@@ -393,9 +313,9 @@ void oct_writer_free(oct_writer *w)
     if (!w)
         return;
     for (int d = 0; d < OCT_MAX_LEVELS; d++)
-        chunked_free(&w->masks[d]);
-    chunked_free(&w->voxels);
-    chunked_free(&w->surfaces);
+        oct_chunks_free(&w->masks[d]);
+    oct_spool_free(&w->voxels);
+    oct_chunks_free(&w->surfaces);
     free(w->function);
     free(w);
 }

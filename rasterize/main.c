@@ -59,6 +59,9 @@ static const char help_text[] =
     "  -h, --help             this text\n"
     "  --version              print the version and exit\n"
     "\n"
+    "Until the end the voxel records wait in an unlinked scratch file in $TMPDIR\n"
+    "(default /tmp), or in memory where none can be made; the output is the same.\n"
+    "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 
 typedef struct progress {
@@ -304,6 +307,9 @@ static int rasterize_scene(const options *o)
     }
     wp.function = function;
     wp.flags = o->shell_only ? OCT_FLAG_SHELL_ONLY : 0;
+    /* the voxel records wait in a scratch file, not in memory (README) */
+    const char *tmpdir = getenv("TMPDIR");
+    wp.spool_dir = tmpdir && *tmpdir ? tmpdir : "/tmp";
     if (bp.shard) { /* the shard's place in its partition, for --merge and --info */
         wp.shard_count = shard.count;
         wp.shard_index = shard.index;

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +16,7 @@
 
 #include "format/oct.h"
 #include "format/oct_layout.h" /* oct__alloc_fail_after */
+#include "format/oct_store.h"  /* oct__spool_limit */
 #include "bench/oct_synth.h"
 #include "tests/oct_check.h"
 
@@ -160,12 +162,14 @@ static void test_writer_write_failures(void **state)
     test_tree_free(&t);
 }
 
-/* Feeds t to a new writer in chunks; on ENOMEM retries the call once when
- * `retry` (a single injected failure must leave the writer usable). */
-static oct_err feed_writer(const test_tree *t, int retry, unsigned char **out, size_t *out_len)
+/* Feeds t to a new writer in chunks, the voxel records spooled in
+ * spool_dir (NULL: in memory); on ENOMEM retries the call once when `retry`
+ * (a single injected failure must leave the writer usable). */
+static oct_err feed_spooled(const test_tree *t, const char *spool_dir, int retry,
+                            unsigned char **out, size_t *out_len)
 {
     oct_writer_params p = {.levels = t->levels, .edge = t->edge, .surface_count = t->surface_count,
-                           .palette = t->palette};
+                           .palette = t->palette, .spool_dir = spool_dir};
     memcpy(p.origin, t->origin, sizeof p.origin);
     oct_writer *w = NULL;
     oct_err rc = oct_writer_create(&p, &w);
@@ -197,21 +201,26 @@ static oct_err feed_writer(const test_tree *t, int retry, unsigned char **out, s
     return rc;
 }
 
-static void test_allocation_failures(void **state)
+static oct_err feed_writer(const test_tree *t, int retry, unsigned char **out, size_t *out_len)
 {
-    (void)state;
-    test_tree t;
-    test_tree_random(&t, 7, 30000, 3, 21, 0);
-    unsigned char *good;
-    size_t good_len;
-    assert_int_equal(feed_writer(&t, 0, &good, &good_len), OCT_OK);
+    return feed_spooled(t, NULL, retry, out, out_len);
+}
+
+/* Every allocation made to fail in turn, once (retried: the same bytes as
+ * `good`) and from then on (OCT_ENOMEM), the records spooled in spool_dir
+ * (NULL: memory) with the scratch file full after spool_limit bytes. */
+static void check_alloc_failures(const test_tree *t, const char *spool_dir, uint64_t spool_limit,
+                                 const unsigned char *good, size_t good_len)
+{
     for (int sticky = 0; sticky <= 1; sticky++) {
         for (long n = 1;; n++) {
             unsigned char *out;
             size_t len;
+            oct__spool_limit(spool_limit);
             oct__alloc_fail_after(n, sticky);
-            oct_err rc = feed_writer(&t, !sticky, &out, &len);
+            oct_err rc = feed_spooled(t, spool_dir, !sticky, &out, &len);
             oct__alloc_fail_after(0, 0);
+            oct__spool_limit(UINT64_MAX);
             if (rc == OCT_OK) {
                 assert_int_equal(len, good_len);
                 assert_memory_equal(out, good, len);
@@ -226,6 +235,17 @@ static void test_allocation_failures(void **state)
             assert_true(n < 1000);
         }
     }
+}
+
+static void test_allocation_failures(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 7, 30000, 3, 21, 0);
+    unsigned char *good;
+    size_t good_len;
+    assert_int_equal(feed_writer(&t, 0, &good, &good_len), OCT_OK);
+    check_alloc_failures(&t, NULL, UINT64_MAX, good, good_len);
     /* The reader allocates its handle and, for a misaligned buffer, a copy. */
     unsigned char *raw = malloc(good_len + 1);
     memcpy(raw + 1, good, good_len);
@@ -263,6 +283,68 @@ static void test_large_tree_spans_chunks(void **state)
     test_tree_free(&t);
 }
 
+/* Entries in directory d other than . and .. */
+static int dir_entries(const char *d)
+{
+    DIR *dir = opendir(d);
+    assert_non_null(dir);
+    int n = 0;
+    for (struct dirent *e; (e = readdir(dir));)
+        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    closedir(dir);
+    return n;
+}
+
+/* The voxel records spooled to a scratch file come back as the same bytes,
+ * whether the file takes them all, refuses them from any point on (a full
+ * disk: the rest in memory) or cannot be made at all; and no file is ever
+ * left in (or named in) the directory. */
+static void test_spooled_records(void **state)
+{
+    (void)state;
+    test_tree t;
+    test_tree_random(&t, 7, 30000, 3, 23, 0);
+    unsigned char *good, *out;
+    size_t good_len, len;
+    assert_int_equal(feed_writer(&t, 0, &good, &good_len), OCT_OK);
+    char dir[] = "/tmp/oct-spool-test-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    const size_t bytes = 4 * t.voxel_count;
+    const uint64_t limits[] = {UINT64_MAX, 0, 1, 4, 4 * 2999, 4 * 3000, 4 * 3000 + 1, 12345,
+                               bytes / 2, bytes - 1, bytes};
+    for (size_t i = 0; i < sizeof limits / sizeof *limits; i++) {
+        oct__spool_limit(limits[i]);
+        assert_int_equal(feed_spooled(&t, dir, 0, &out, &len), OCT_OK);
+        oct__spool_limit(UINT64_MAX);
+        assert_int_equal(len, good_len);
+        assert_memory_equal(out, good, len);
+        free(out);
+    }
+    /* no directory, or not a directory: memory */
+    const char *nowhere[] = {"/nonexistent-oct-spool-dir", "/dev/null", ""};
+    for (size_t i = 0; i < sizeof nowhere / sizeof *nowhere; i++) {
+        assert_int_equal(feed_spooled(&t, nowhere[i], 0, &out, &len), OCT_OK);
+        assert_int_equal(len, good_len);
+        assert_memory_equal(out, good, len);
+        free(out);
+    }
+    /* the scratch file has no name while the writer holds it */
+    oct_writer_params p = {.levels = t.levels, .edge = t.edge, .surface_count = t.surface_count,
+                           .palette = t.palette, .spool_dir = dir};
+    oct_writer *w;
+    assert_int_equal(oct_writer_create(&p, &w), OCT_OK);
+    assert_int_equal(oct_writer_add_voxels(w, t.voxels, t.surfaces, 100), OCT_OK);
+    assert_int_equal(dir_entries(dir), 0);
+    oct_writer_free(w);
+    /* allocation failures anywhere, half the records in the file, half in
+       memory */
+    check_alloc_failures(&t, dir, bytes / 2, good, good_len);
+    assert_int_equal(dir_entries(dir), 0);
+    assert_int_equal(rmdir(dir), 0);
+    free(good);
+    test_tree_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -270,6 +352,7 @@ int main(void)
         cmocka_unit_test(test_writer_write_failures),
         cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_large_tree_spans_chunks),
+        cmocka_unit_test(test_spooled_records),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -70,6 +70,15 @@ done
 "$BIN/rasterize" "$T/s2.scene" -o "$T/t2.oct" --levels 7 --threads 2 -q || fail "threads 2"
 cmp -s "$T/t1.oct" "$T/t2.oct" || fail "thread count changed the output"
 
+# ... and wherever the voxel records wait: a scratch file in $TMPDIR, or
+# memory when there is no such directory; no scratch file is left behind.
+mkdir "$T/spool"
+TMPDIR="$T/spool" "$BIN/rasterize" "$T/s2.scene" -o "$T/t3.oct" --levels 7 -q || fail "spooled"
+TMPDIR="$T/none" "$BIN/rasterize" "$T/s2.scene" -o "$T/t4.oct" --levels 7 -q || fail "no TMPDIR"
+cmp -s "$T/t1.oct" "$T/t3.oct" || fail "the spool changed the output"
+cmp -s "$T/t1.oct" "$T/t4.oct" || fail "the memory fallback changed the output"
+[ -z "$(ls -A "$T/spool")" ] || fail "scratch file left in TMPDIR"
+
 # ... and whatever build of the lane evaluators runs (AVX2 where the
 # processor has it, or the portable one): levels 8, where the voxels'
 # re-tests run on lanes, on scenes with and without kinks and several
