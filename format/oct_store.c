@@ -114,6 +114,7 @@ void oct_spool_open(oct_spool *s, const char *dir)
 {
     memset(s, 0, sizeof *s);
     s->fd = -1;
+    s->crc = crc32_z(0, NULL, 0);
     if (!dir || !*dir || (s->fd = scratch_file(dir)) < 0)
         return;
     if (!(s->buf = oct__realloc(NULL, READ_BLOCK))) {
@@ -128,6 +129,7 @@ int oct_spool_append(oct_spool *s, const void *data, size_t n)
 {
     const unsigned char *p = data;
     const uint64_t start = s->on_disk;
+    const size_t all = n;
     while (n && s->has_file && !s->file_full) {
         size_t k = n < ((size_t)1 << 30) ? n : (size_t)1 << 30;
         if (spool_limit - s->on_disk < k)
@@ -154,6 +156,7 @@ int oct_spool_append(oct_spool *s, const void *data, size_t n)
         s->on_disk = start; /* all or nothing: the file's bytes past start are dropped */
         return -1;
     }
+    s->crc = crc32_z(s->crc, data, all);
     return 0;
 }
 

@@ -12,6 +12,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <zlib.h>
+
 #include "format/oct_sink.h"
 
 #define OCT_CHUNK_BITS 21
@@ -42,6 +44,7 @@ typedef struct oct_spool {
                            so that the writer's finish allocates nothing) */
     uint64_t on_disk; /* the first on_disk bytes are in the file */
     oct_chunks mem;   /* the bytes after them */
+    uLong crc;        /* CRC-32 of all the bytes appended, kept as they come */
 } oct_spool;
 
 /* An empty spool whose bytes go to an unlinked file in directory `dir`
@@ -51,6 +54,9 @@ void oct_spool_open(oct_spool *s, const char *dir);
  * takes them. */
 int oct_spool_append(oct_spool *s, const void *data, size_t n);
 static inline uint64_t oct_spool_size(const oct_spool *s) { return s->on_disk + s->mem.n; }
+/* The CRC-32 (zlib's) of the bytes appended: what a pass of oct_spool_put
+ * would compute, without reading them back. */
+static inline uint32_t oct_spool_crc(const oct_spool *s) { return (uint32_t)s->crc; }
 /* The stored bytes into sink, in order; -1 with errno set when the file
  * cannot be read back or the sink fails. */
 int oct_spool_put(const oct_spool *s, oct_sink *sink);
