@@ -127,6 +127,8 @@ void oct_spool_open(oct_spool *s, const char *dir)
 
 int oct_spool_append(oct_spool *s, const void *data, size_t n)
 {
+    if (n == 0)
+        return 0; /* (data may be NULL then: zlib's CRC would restart) */
     const unsigned char *p = data;
     const uint64_t start = s->on_disk;
     const size_t all = n;

@@ -188,6 +188,8 @@ static oct_err feed_spooled(const test_tree *t, const char *spool_dir, int retry
         rc = oct_writer_add_voxels(w, t->voxels + i, t->surfaces + i, n);
         if (rc == OCT_ENOMEM && retry)
             rc = oct_writer_add_voxels(w, t->voxels + i, t->surfaces + i, n);
+        if (rc == OCT_OK) /* nothing, which may come without an array */
+            rc = oct_writer_add_voxels(w, NULL, NULL, 0);
     }
     char *mem = NULL;
     size_t len = 0;
