@@ -1,5 +1,7 @@
-/* oct_write: the streaming .oct writer — per-depth buffers of masks, then one
- * deterministic serialization (bases and CRCs computed at finish). */
+/* oct_write: the streaming .oct writer — per-depth buffers of masks and a
+ * spool of voxel records (format/oct_store.h), then one deterministic
+ * serialization (bases and CRCs computed at finish; the records' CRC is kept
+ * as they come). */
 #include "format/oct.h"
 #include "format/oct_layout.h"
 #include "format/oct_sink.h"
