@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "format/oct_layout.h"
@@ -122,6 +123,9 @@ void oct_spool_open(oct_spool *s, const char *dir)
         return;
     }
     s->has_file = 1;
+    /* a shared /tmp is not ours to fill: at most half of what is free now */
+    struct statvfs sv;
+    s->file_cap = fstatvfs(s->fd, &sv) == 0 ? (uint64_t)sv.f_bavail * sv.f_frsize / 2 : UINT64_MAX;
 }
 
 int oct_spool_append(oct_spool *s, const void *data, size_t n)
@@ -133,17 +137,16 @@ int oct_spool_append(oct_spool *s, const void *data, size_t n)
     const size_t all = n;
     while (n && s->has_file && !s->file_full) {
         size_t k = n < ((size_t)1 << 30) ? n : (size_t)1 << 30;
-        if (spool_limit - s->on_disk < k)
-            k = (size_t)(spool_limit - s->on_disk); /* (tests) */
-        ssize_t w;
-        if (k == 0) {
-            spool_limit = UINT64_MAX; /* refused once: a disk whose space comes back */
-            errno = ENOSPC;
-            w = -1;
-        } else {
+        const uint64_t room = (s->file_cap < spool_limit ? s->file_cap : spool_limit) - s->on_disk;
+        if (room < k)
+            k = (size_t)room;
+        ssize_t w = -1;
+        if (k) {
             w = pwrite(s->fd, p, k, (off_t)s->on_disk);
             if (w < 0 && errno == EINTR)
                 continue;
+        } else if (spool_limit <= s->file_cap) {
+            spool_limit = UINT64_MAX; /* (tests) refused once: a disk whose space comes back */
         }
         if (w <= 0) {
             s->file_full = 1; /* the rest, from here on, in memory */

@@ -4,8 +4,9 @@
  * oct_spool keeps them in an unlinked scratch file instead, so that the
  * largest part of a deep file (the voxel records) does not have to sit in
  * the process's memory until the end; where no scratch file can be made, or
- * it stops taking bytes (a full disk), the rest goes to memory. Either way
- * the bytes come back in the order they were appended. */
+ * it stops taking bytes (a full disk, or half the space that was free when
+ * it was made: a shared /tmp is left room), the rest goes to memory. Either
+ * way the bytes come back in the order they were appended. */
 #ifndef OCT_STORE_H
 #define OCT_STORE_H
 
@@ -42,6 +43,8 @@ typedef struct oct_spool {
     int file_full;    /* it refused bytes: nothing more is written to it */
     unsigned char *buf; /* with the file: the read-back's block (allocated at open,
                            so that the writer's finish allocates nothing) */
+    uint64_t file_cap; /* it takes at most this many bytes: half the space free
+                          in its filesystem when it was made */
     uint64_t on_disk; /* the first on_disk bytes are in the file */
     oct_chunks mem;   /* the bytes after them */
     uLong crc;        /* CRC-32 of all the bytes appended, kept as they come */

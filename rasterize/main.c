@@ -60,7 +60,8 @@ static const char help_text[] =
     "  --version              print the version and exit\n"
     "\n"
     "Until the end the voxel records wait in an unlinked scratch file in $TMPDIR\n"
-    "(default /tmp), or in memory where none can be made; the output is the same.\n"
+    "(default /tmp; at most half its free space), or in memory where none can be\n"
+    "made; the output is the same.\n"
     "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "format/oct.h"
@@ -347,6 +348,48 @@ static void test_spooled_records(void **state)
     test_tree_free(&t);
 }
 
+/* The scratch file takes at most half the space that was free where it
+ * was made; past its cap the bytes go to memory, and all come back in order
+ * with the CRC of what was appended. */
+static void test_spool_leaves_room(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/oct-spool-test-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    struct statvfs before, after;
+    assert_int_equal(statvfs(dir, &before), 0);
+    oct_spool s;
+    oct_spool_open(&s, dir);
+    assert_int_equal(statvfs(dir, &after), 0);
+    assert_true(s.has_file);
+    const uint64_t a = (uint64_t)before.f_bavail * before.f_frsize / 2,
+                   b = (uint64_t)after.f_bavail * after.f_frsize / 2;
+    const uint64_t slack = (uint64_t)64 << 20; /* other writers to the same disk */
+    assert_true(s.file_cap + slack >= (a < b ? a : b));
+    assert_true(s.file_cap <= (a > b ? a : b) + slack);
+    s.file_cap = 1000; /* a nearly full disk */
+    unsigned char bytes[3000];
+    for (size_t i = 0; i < sizeof bytes; i++)
+        bytes[i] = (unsigned char)(i * 7 + (i >> 8));
+    for (size_t i = 0; i < sizeof bytes; i += 700)
+        assert_int_equal(oct_spool_append(&s, bytes + i, sizeof bytes - i < 700 ? sizeof bytes - i : 700), 0);
+    assert_int_equal(s.on_disk, 1000);
+    assert_int_equal(s.mem.n, 2000);
+    assert_int_equal(oct_spool_crc(&s), (uint32_t)crc32_z(0, bytes, sizeof bytes));
+    char *mem = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&mem, &len);
+    oct_sink sink = {f, 0, 0, 1};
+    assert_int_equal(oct_spool_put(&s, &sink), 0);
+    fclose(f);
+    assert_int_equal(len, sizeof bytes);
+    assert_memory_equal(mem, bytes, sizeof bytes);
+    free(mem);
+    oct_spool_free(&s);
+    assert_int_equal(dir_entries(dir), 0);
+    assert_int_equal(rmdir(dir), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -355,6 +398,7 @@ int main(void)
         cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_large_tree_spans_chunks),
         cmocka_unit_test(test_spooled_records),
+        cmocka_unit_test(test_spool_leaves_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
