@@ -35,8 +35,8 @@ static void newton_start(newton *nw, const double centre[3], const double fg_cen
 
 /* The Newton step from p (f and grad f there: f, g), kept inside the voxel
  * (box), into q; 0 when it cannot be taken (q untouched). */
-static inline int newton_step(const double p[3], double f, const double g[3], const interval box[3],
-                       double q[3])
+static inline int newton_step(const double p[3], double f, const double g[3],
+                              const interval box[3], double q[3])
 {
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)

@@ -1,5 +1,6 @@
 /* The .oct writer's contract (format/oct_write.c): usage errors, failing
- * writes and allocation failures. */
+ * writes and allocation failures, and the same bytes wherever the voxel
+ * records wait (format/oct_store.c: a scratch file, memory, or both). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
