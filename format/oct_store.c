@@ -166,20 +166,17 @@ int oct_spool_append(oct_spool *s, const void *data, size_t n)
 
 int oct_spool_put(const oct_spool *s, oct_sink *sink)
 {
-    unsigned char *buf = s->buf;
-    if (s->on_disk) {
-        for (uint64_t o = 0; o < s->on_disk;) {
-            const size_t k = s->on_disk - o < READ_BLOCK ? (size_t)(s->on_disk - o) : READ_BLOCK;
-            const ssize_t r = pread(s->fd, buf, k, (off_t)o);
-            if (r < 0 && errno == EINTR)
-                continue;
-            if (r <= 0 || oct_sink_put(sink, buf, (size_t)r) != 0) {
-                if (r == 0)
-                    errno = EIO; /* the file is shorter than what was written to it */
-                return -1;
-            }
-            o += (uint64_t)r;
+    for (uint64_t o = 0; o < s->on_disk;) {
+        const size_t k = s->on_disk - o < READ_BLOCK ? (size_t)(s->on_disk - o) : READ_BLOCK;
+        const ssize_t r = pread(s->fd, s->buf, k, (off_t)o);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0 || oct_sink_put(sink, s->buf, (size_t)r) != 0) {
+            if (r == 0)
+                errno = EIO; /* the file is shorter than what was written to it */
+            return -1;
         }
+        o += (uint64_t)r;
     }
     return oct_chunks_put(&s->mem, sink);
 }
