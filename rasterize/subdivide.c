@@ -2,9 +2,11 @@
  * children in slot order, so every depth's nodes come out in Morton order.
  * Above the finest MEAN_VALUE_LEVELS a child is tested on its own with its
  * parent's pruned tapes (cell_test_surviving); there and below, all eight at once with
- * the mean-value form (child_enclosures). */
+ * the mean-value form (child_enclosures); a leaf-parent's voxels then take
+ * the re-tests of voxel_retest.c. */
 #include "rasterize/build_internal.h"
 #include "rasterize/cell_geometry.h"
+#include "rasterize/voxel_retest.h"
 
 #define MEAN_VALUE_LEVELS 3   /* the finest levels whose cells the mean-value form tests */
 _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradient enclosure");
@@ -16,129 +18,6 @@ _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradie
 
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
                           const node_form *given);
-
-/* f and its gradient at n voxel centres (tape_eval_grad_lanes). With
- * --shell-only and one surface only f is wanted (the centred re-test's
- * skip; no record, no choice of surface): the value evaluator, the same
- * bits of f, and the gradients left 0. */
-static void centre_values(worker *wk, const tape *t, unsigned n, const double *x, const double *y,
-                          const double *z, double *f, double g[3][TAPE_LANES])
-{
-    wk->st.point_evals += n;
-    if (wk->c->par->shell_only && wk->c->nsurf == 1) {
-        tape_eval_lanes(t, n, x, y, z, f, wk->lslots);
-        memset(g, 0, 3 * sizeof *g);
-        return;
-    }
-    tape_eval_grad_lanes(t, n, x, y, z, f, g, wk->lslots);
-}
-
-/* The tape for f at voxel centres: the record tape (record_tapes), whose
- * bits the records take; with --shell-only and one surface, where f serves
- * only the centred re-test's skip (which only keeps voxels, its margin
- * covering the pruned constants), the node's pruned one. */
-static const tape *centre_tape(const worker *wk, const tape *pruned, unsigned s)
-{
-    return wk->c->par->shell_only && wk->c->nsurf == 1 ? pruned : &wk->rec[s];
-}
-
-/* With --shell-only and one surface, f at a child's centre serves only the
- * centred re-test: the candidates (cand) where the node's form (fc at
- * centre c, G) shows that the re-test keeps the child whatever f is there
- * are returned (their re-tests are not run, no evaluation), their entries
- * of cf8 filled with zeros. */
-static uint8_t skip_centres(const worker *wk, interval fc, const interval G[3], const double c[3],
-                            const child_boxes *cb, uint8_t cand, double *cf8)
-{
-    if (!wk->c->par->shell_only || wk->c->nsurf != 1 || !cand)
-        return 0;
-    uint8_t m = centred_form_cannot_exclude(fc, G, c, cb, cand);
-    for (unsigned i = 0; i < 8; i++)
-        if ((m >> i) & 1)
-            memset(cf8 + 4 * i, 0, 4 * sizeof *cf8);
-    return m;
-}
-
-/* For a leaf-parent: f and its gradient at the centres of the children that
- * the mean-value form leaves to the centred re-test, surface by surface, one
- * pass over the tape for all of them (tape_eval_grad_lanes), into wk->cf8. */
-static void leaf_centres(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *fx,
-                         child_boxes *cb)
-{
-    const build_ctx *c = wk->c;
-    const unsigned ns = c->nsurf, pidx = depth + 1;
-    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
-        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, lane[8];
-        wk->cf8_have[s] = 0;
-        if (!ok[k])
-            continue;
-        double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
-        for (unsigned i = 0; i < 8; i++) {
-            if ((fx[k] >> i) & 1 || !child_box(cb, i))
-                continue;
-            x[n] = cb->centre[i][0];
-            y[n] = cb->centre[i][1];
-            z[n] = cb->centre[i][2];
-            lane[n++] = i;
-        }
-        if (!n)
-            continue;
-        centre_values(wk, centre_tape(wk, &wk->tapes[(size_t)pidx * ns + s], s), n, x, y, z, f, g);
-        for (unsigned l = 0; l < n; l++) {
-            double *fg = wk->cf8 + ((size_t)s * 8 + lane[l]) * 4;
-            fg[0] = f[l];
-            fg[1] = g[0][l];
-            fg[2] = g[1][l];
-            fg[3] = g[2][l];
-            wk->cf8_have[s] |= (uint8_t)(1u << lane[l]);
-        }
-        if (wk->kinked[(size_t)pidx * ns + s])
-            wk->cf8_have[s] = 0;
-    }
-}
-
-/* For a leaf-parent, after leaf_centres: the children whose re-tests drop
- * them, per surface (index k as in ok): the form centred on each voxel, then
- * on a tape with a kink the plain interval test too (there the gradient
- * enclosure spans both branches and the forms are loose where the interval
- * is not: csg, gyroid). Each test runs on all the children at once. Bit i of
- * centred[k] marks a drop by the form, of plain[k] by the plain test. */
-static void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *fx,
-                         child_boxes *cb, uint8_t *centred, uint8_t *plain)
-{
-    const build_ctx *c = wk->c;
-    const unsigned ns = c->nsurf, pidx = depth + 1;
-    for (unsigned k = 0; k < wk->nact[pidx]; k++) {
-        unsigned s = wk->act[(size_t)pidx * ns + k], n = 0, m = 0;
-        centred[k] = plain[k] = 0;
-        if (!ok[k])
-            continue;
-        retest_item it[8];
-        uint8_t child[8], drop[8];
-        for (unsigned i = 0; i < 8; i++)
-            if (!((fx[k] >> i) & 1) && child_box(cb, i)) {
-                retest_item r = {cb->box[i], cb->centre[i], wk->cf8[((size_t)s * 8 + i) * 4]};
-                child[n] = (uint8_t)i;
-                it[n++] = r;
-            }
-        const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-        centred_form_drops(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], it, n, drop);
-        for (unsigned j = 0; j < n; j++) {
-            if (drop[j])
-                centred[k] |= (uint8_t)(1u << child[j]);
-            else { /* the plain test's candidates */
-                child[m] = child[j];
-                it[m++] = it[j];
-            }
-        }
-        if (!wk->kinked[(size_t)pidx * ns + s])
-            continue;
-        plain_test_drops(wk, t, s, it, m, drop);
-        for (unsigned j = 0; j < m; j++)
-            if (drop[j])
-                plain[k] |= (uint8_t)(1u << child[j]);
-    }
-}
 
 /* Whether a child of the node (depth) takes the plain interval test for
  * surface k after the node's mean-value form (ok: that form was available):
@@ -190,19 +69,6 @@ static int child_dropped(worker *wk, unsigned depth, int ok, int plain_drop, uns
     wk->st.taylor_drops += retest & 1;
     return retest != 0;
 }
-
-/* A leaf-parent waiting in a batch (leaf_batch): a single-surface scene's
- * leaf-parents under one node are tested together, so that the lane
- * evaluators get the candidate voxels of all of them at once. */
-typedef struct leaf_parent {
-    uint64_t cell[3];
-    unsigned slot; /* which child of its parent */
-    interval pbox[3];
-    double pc[3];
-    uint8_t ok[1], fx[1], cand, nofd, cf8_have, centred[1], plain[1]; /* nofd: see skip_centres */
-    child_boxes cb;
-    double cf8[32];
-} leaf_parent;
 
 /* The n nodes (depth, cell[j], slot[j] of their parent) that the parent's
  * visit_children let through, of a single-surface scene, on the mean-value
@@ -346,99 +212,6 @@ static uint8_t kept_voxels(worker *wk, const leaf_parent *p)
     }
     wk->st.voxels += n;
     return keep;
-}
-
-/* For leaf_batch: the leaf-parents' forms (the node's, reused), their
- * candidate voxels, and f and its gradient at the centres of those that
- * need them (not skip_centres'), in passes of TAPE_LANES points. */
-static void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
-{
-    const build_ctx *c = wk->c;
-    const unsigned pidx = depth + 1;
-    const tape *t = &wk->tapes[pidx], *ct = centre_tape(wk, t, 0);
-    interval *G = &wk->grad[pidx * 3];
-    double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
-    unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES];
-    for (unsigned b = 0; b < nb; b++) {
-        leaf_parent *p = &lp[b];
-        cell_box(c, depth, p->cell, p->pbox, p->pc);
-        p->ok[0] = (uint8_t)child_enclosures(wk, t, p->pbox, depth, p->cell, wk->ncen[depth],
-                                             &wk->fcen[pidx], G, 1, &p->fx[0]);
-        child_boxes_init(c, depth, p->cell, p->pbox, &p->cb);
-        p->cand = p->nofd = p->cf8_have = p->centred[0] = p->plain[0] = 0;
-        for (unsigned i = 0; i < 8 && p->ok[0]; i++)
-            if (!((p->fx[0] >> i) & 1) && child_box(&p->cb, i))
-                p->cand |= (uint8_t)(1u << i);
-        p->nofd = skip_centres(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, p->cand, p->cf8);
-        for (unsigned i = 0; i < 8; i++) { /* f and grad f at the candidates' centres */
-            if (((p->cand & ~p->nofd) >> i) & 1) {
-                x[n] = p->cb.centre[i][0];
-                y[n] = p->cb.centre[i][1];
-                z[n] = p->cb.centre[i][2];
-                owner[n] = b;
-                ch[n++] = i;
-            }
-            if (n == TAPE_LANES || (n && b + 1 == nb && i == 7)) {
-                centre_values(wk, ct, n, x, y, z, f, g);
-                for (unsigned l = 0; l < n; l++) {
-                    leaf_parent *q = &lp[owner[l]];
-                    double *fg = q->cf8 + 4 * ch[l];
-                    fg[0] = f[l];
-                    fg[1] = g[0][l];
-                    fg[2] = g[1][l];
-                    fg[3] = g[2][l];
-                    q->cf8_have |= (uint8_t)(1u << ch[l]);
-                }
-                n = 0;
-            }
-        }
-    }
-}
-
-/* For leaf_batch: the re-tests of all the leaf-parents' candidates at
- * once: the centred form on those with f at their centre, then on a kinked
- * tape the plain test on all that the form left. */
-static void batch_retests(worker *wk, unsigned pidx, leaf_parent *lp, unsigned nb)
-{
-    const tape *t = &wk->tapes[pidx];
-    const interval *G = &wk->grad[pidx * 3];
-    unsigned nit = 0;
-    retest_item it[64];
-    uint8_t it_lp[64], it_ch[64], drop[64];
-    unsigned m = 0, nfd = 0, fdj[64];
-    retest_item fit[64];
-    uint8_t fdrop[64];
-    for (unsigned b = 0; b < nb; b++)
-        for (unsigned i = 0; i < 8; i++)
-            if ((lp[b].cand >> i) & 1) {
-                retest_item r = {lp[b].cb.box[i], lp[b].cb.centre[i], lp[b].cf8[4 * i]};
-                it_lp[nit] = (uint8_t)b;
-                it_ch[nit] = (uint8_t)i;
-                drop[nit] = 0;
-                if (!((lp[b].nofd >> i) & 1)) {
-                    fdj[nfd] = nit;
-                    fit[nfd++] = r;
-                }
-                it[nit++] = r;
-            }
-    centred_form_drops(wk, t, G, fit, nfd, fdrop);
-    for (unsigned j = 0; j < nfd; j++)
-        drop[fdj[j]] = fdrop[j];
-    for (unsigned j = 0; j < nit; j++) {
-        if (drop[j]) {
-            lp[it_lp[j]].centred[0] |= (uint8_t)(1u << it_ch[j]);
-        } else {
-            it_lp[m] = it_lp[j];
-            it_ch[m] = it_ch[j];
-            it[m++] = it[j];
-        }
-    }
-    if (wk->kinked[pidx]) {
-        plain_test_drops(wk, t, 0, it, m, drop);
-        for (unsigned j = 0; j < m; j++)
-            if (drop[j])
-                lp[it_lp[j]].plain[0] |= (uint8_t)(1u << it_ch[j]);
-    }
 }
 
 /* The leaf-parents (depth = levels - 1) of one node of a single-surface
