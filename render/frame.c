@@ -1,6 +1,7 @@
 /* frame: multi-threaded tile renderer for one view. */
 #include "render/frame.h"
 #include "render/frame_impl.h"
+#include "render/frame_srgb.h"
 
 #include <errno.h>
 #include <float.h>
@@ -16,7 +17,6 @@
 
 #include "common/limits.h"
 #include "common/test_hooks.h"
-#include "common/view/image.h"
 #include "render/ao.h"
 #include "render/beam.h"
 #include "render/map_guard.h"
@@ -99,66 +99,6 @@ double frame_ticks(void)
 }
 #endif
 
-/* image_srgb8 without pow: the code value is the number of thresholds at or
- * below the input, where threshold k is the least float whose image_srgb8
- * is >= k (found by bisection over the float bit patterns, image_srgb8 being
- * monotone). The count starts at the code of the input's bucket [i, i + 1) /
- * 4096 (i / 4096 is exact, so that code is a lower bound) and steps past
- * the one or two thresholds inside the bucket. Bit for bit image_srgb8, NaN
- * and out-of-range inputs included; tests/test_frame.c compares the two
- * over every float in [0, 1]. */
-static float srgb_threshold[257]; /* [256] = NaN ends the count */
-#define SRGB_BUCKETS 4096
-static uint8_t srgb_bucket[SRGB_BUCKETS + 1];
-static pthread_once_t srgb_once = PTHREAD_ONCE_INIT;
-
-static float float_of_bits(uint32_t b)
-{
-    float f;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-
-static void srgb_init(void)
-{
-    srgb_threshold[0] = -INFINITY;
-    for (unsigned k = 1; k < 256; k++) {
-        uint32_t lo = 0, hi = 0x3f800000u; /* image_srgb8(1.0f) == 255 >= k */
-        while (lo < hi) {
-            uint32_t mid = lo + (hi - lo) / 2;
-            if (image_srgb8(float_of_bits(mid)) >= k)
-                hi = mid;
-            else
-                lo = mid + 1;
-        }
-        srgb_threshold[k] = float_of_bits(lo);
-    }
-    srgb_threshold[256] = NAN; /* no x is >= it, +inf included */
-    for (unsigned i = 0; i <= SRGB_BUCKETS; i++)
-        srgb_bucket[i] = image_srgb8((float)i / SRGB_BUCKETS);
-}
-
-static inline uint8_t srgb8_fast(float x)
-{
-    if (!(x > 0.0f)) /* misses on a black background, NaN */
-        return 0;
-    unsigned k = srgb_bucket[x < 1.0f ? (unsigned)(x * SRGB_BUCKETS) : SRGB_BUCKETS];
-    while (x >= srgb_threshold[k + 1])
-        k++;
-    return (uint8_t)k;
-}
-
-uint8_t frame_srgb8(float x)
-{
-    pthread_once(&srgb_once, srgb_init);
-    return srgb8_fast(x);
-}
-
-uint8_t frame_srgb8_ready(float x)
-{
-    return srgb8_fast(x);
-}
-
 /* Pixel (i, j)'s probe in the tile's. */
 static inline aa_probe *tile_probe(frame_tile *tl, uint32_t i, uint32_t j)
 {
@@ -194,7 +134,7 @@ static inline void render_pixel(const frame_shared *sh, frame_acc *acc, uint32_t
     frame_shade_sample(sh, acc, &h, dir, i, j, 0, job->shade.ao_rays, job->shade.ao_rays, rgb, n);
     const size_t px = (size_t)j * job->cam->width + i;
     for (int a = 0; a < 3; a++)
-        job->rgb[3 * px + (size_t)a] = srgb8_fast(rgb[a]);
+        job->rgb[3 * px + (size_t)a] = frame_srgb8_ready(rgb[a]);
     if (job->depth)
         job->depth[px] = h.t > FLT_MAX ? (isinf(h.t) ? INFINITY : FLT_MAX) : (float)h.t;
     if (job->normals)
@@ -531,7 +471,7 @@ static int keep_border(frame_keep *k, size_t ntiles)
 
 int frame_render(const frame_job *job, frame_stats *stats)
 {
-    pthread_once(&srgb_once, srgb_init);
+    frame_srgb_setup();
     memset(stats, 0, sizeof *stats);
     frame_sync sy;
     memset(&sy, 0, sizeof sy);

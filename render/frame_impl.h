@@ -59,9 +59,6 @@ double frame_now_ns(void);
  * thread's pass (frame.c's work). */
 double frame_ticks(void);
 
-/* frame_srgb8 once a frame_render has set its tables up. */
-uint8_t frame_srgb8_ready(float x);
-
 /* Shades a traced sample of pixel (i, j) seen along `dir`: the shadow ray,
  * AO rays k0 .. k0 + ao_count - 1 of ao_total, the colour; n gets the
  * facing normal. */

@@ -4,6 +4,7 @@
  * packets under the paper's rule (trace_packet.h), else one by one from the
  * pixel's anchor. */
 #include "render/frame_impl.h"
+#include "render/frame_srgb.h"
 
 #include <math.h>
 #include <stdlib.h>
