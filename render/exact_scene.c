@@ -250,6 +250,7 @@ void exact_worker_new_frame(exact_worker *w)
     w->have = 0;
     w->have_curv = 0;
     w->exit_t = NAN;
+    w->clear_to = -INFINITY;
     w->line_new = 1;
     memset(w->key, 0, sizeof w->key);
     /* (no ray's: its d is finite and not all 0) */
@@ -260,7 +261,7 @@ void exact_worker_new_frame(exact_worker *w)
 int exact_worker_init(exact_worker *w, const exact_scene *es)
 {
     w->scene = es;
-    w->fast = w->slow = w->beyond = 0;
+    w->fast = w->slow = w->beyond = w->skipped = 0;
     w->bound_min_n = EXACT_BOUND_MIN_N;
     exact_worker_new_frame(w);
     w->bound = exact_line_alloc(es->ncand ? es->ncand : 1, sizeof *w->bound);
@@ -375,17 +376,33 @@ static inline double region_exit(exact_worker *w, const trace_ray *r, const uint
  * leaves the region (its box holds those points too, so the model's bounds
  * hold there), and place it. That root is the ray's hit (the cell has no
  * other surface, and voxels before a hold no root), so the region's next
- * voxels need no test. EXACT_FAST_ROOT with *t, grad; else EXACT_FAST_NONE
- * (the voxel's own answer). */
+ * voxels need no test. Where the whole span is undecided, the span to
+ * BEYOND_NEAR voxels past b is asked. A span certified root-free instead
+ * is kept (w->clear_to): the voxels inside it need no test either.
+ * EXACT_FAST_ROOT with *t, grad; else EXACT_FAST_NONE (the voxel's own
+ * answer). */
+#define BEYOND_NEAR 2.0
 static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t c[3], unsigned shift,
                        uint64_t key, const tape *t_exact, double a, double b, double curv,
                        double *t, double grad[3])
 {
-    const double e = region_exit(w, r, c, shift, key);
+    double e = region_exit(w, r, c, shift, key);
     if (!(e > b))
         return EXACT_FAST_NONE;
-    if (exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad) !=
-        EXACT_FAST_ROOT)
+    int st = exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad);
+    if (st == EXACT_FAST_UNDECIDED) {
+        /* local t crosses a voxel along the ray's major axis in 1 / max |d_k| */
+        const double dx = fabs(r->d[0]), dy = fabs(r->d[1]), dz = fabs(r->d[2]);
+        const double dm = dx > dy ? (dx > dz ? dx : dz) : (dy > dz ? dy : dz);
+        const double near = b + BEYOND_NEAR / dm;
+        if (!(near < e))
+            return EXACT_FAST_NONE;
+        e = near;
+        st = exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad);
+    }
+    if (st == EXACT_FAST_NONE)
+        w->clear_to = e;
+    if (st != EXACT_FAST_ROOT)
         return EXACT_FAST_NONE;
     w->beyond++;
     return EXACT_FAST_ROOT;
@@ -429,9 +446,14 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
         w->have = 0;
         w->have_curv = 0;
         w->exit_t = NAN;
+        w->clear_to = -INFINITY;
     }
     w->key_t = t_in;
     double a = t_in - w->widen, b = t_out + w->widen;
+    if (b <= w->clear_to) { /* inside a span already certified root-free */
+        w->skipped++;
+        return 0;
+    }
     if (a < -r->t_base)
         a = -r->t_base; /* the caller's t >= 0 */
     double best = INFINITY;

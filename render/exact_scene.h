@@ -74,6 +74,8 @@ typedef struct exact_worker {
     exact_sub_cache sub; /* its own sub-cells */
     uint64_t fast, slow; /* statistics: candidate tests the fast path decided, and not */
     uint64_t beyond;     /* statistics: hits placed past their voxel (root_beyond) */
+    uint64_t skipped;    /* statistics: voxels inside a span root_beyond had
+                            certified root-free, not tested */
     /* The fast path's models (exact_fast.h) for the line of the last test
      * (key: o, d; key_t: its t_in), valid while its voxels stay in one
      * coarse cell: candidate k of the cell has one when bit k of `have` is
@@ -95,6 +97,8 @@ typedef struct exact_worker {
     exact_line line;
     double exit_t;     /* where the line leaves region exit_key (NaN: not made) */
     uint64_t exit_key;
+    double clear_to;   /* the cell's one surface has no root on the line from
+                          the last voxel tested up to here (root_beyond) */
     double widen;
     int line_new;
     /* per candidate of the scene, made on first use: its cell's a-priori
