@@ -266,9 +266,10 @@ typedef struct oct_writer_params {
     uint64_t morton_lo, morton_hi;
     const void *function;      /* FUNCTION section bytes (FORMAT.md §8), copied; NULL: none */
     size_t function_size;
-    /* Where the voxel records wait until finish: an unlinked scratch file in
-     * this directory (format/oct_store.h), or memory where none can be made
-     * there or it fills up; NULL: memory. The file's bytes are the same. */
+    /* Where the voxel records, and with several surfaces their surface
+     * indices, wait until finish: unlinked scratch files in this directory
+     * (format/oct_store.h), or memory where none can be made there or one
+     * fills up; NULL: memory. The file's bytes are the same. */
     const char *spool_dir;
 } oct_writer_params;
 
@@ -276,7 +277,8 @@ typedef struct oct_writer_params {
  * in their final (breadth-first, Morton) order; depths are independent
  * streams, so a producer can emit finished subtrees as they come, one depth
  * at a time, and the levels above them at the end. Memory held is the output
- * itself, once, less the voxel records when they are spooled (spool_dir). */
+ * itself, once, less the voxel records and surface indices when they are
+ * spooled (spool_dir). */
 oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out);
 oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks, size_t n);
 /* `surfaces` may be NULL when surface_count == 1; `voxels` may be NULL with

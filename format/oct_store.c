@@ -110,7 +110,7 @@ static int scratch_file(const char *dir)
 
 #define READ_BLOCK ((size_t)1 << 20)
 
-void oct_spool_open(oct_spool *s, const char *dir)
+void oct_spool_open(oct_spool *s, const char *dir, unsigned share_num, unsigned share_den)
 {
     memset(s, 0, sizeof *s);
     s->fd = -1;
@@ -123,9 +123,12 @@ void oct_spool_open(oct_spool *s, const char *dir)
         return;
     }
     s->has_file = 1;
-    /* a shared /tmp is not ours to fill: at most half of what is free now */
+    /* a shared /tmp is not ours to fill: at most half of what is free now,
+     * split between the spools */
     struct statvfs sv;
-    s->file_cap = fstatvfs(s->fd, &sv) == 0 ? (uint64_t)sv.f_bavail * sv.f_frsize / 2 : UINT64_MAX;
+    s->file_cap = fstatvfs(s->fd, &sv) == 0
+                      ? (uint64_t)sv.f_bavail * sv.f_frsize / 2 / share_den * share_num
+                      : UINT64_MAX;
 }
 
 int oct_spool_append(oct_spool *s, const void *data, size_t n)

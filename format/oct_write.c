@@ -1,7 +1,7 @@
-/* oct_write: the streaming .oct writer — per-depth buffers of masks and a
- * spool of voxel records (format/oct_store.h), then one deterministic
- * serialization (bases and CRCs computed at finish; the records' CRC is kept
- * as they come). */
+/* oct_write: the streaming .oct writer — per-depth buffers of masks and
+ * spools of voxel records and surface indices (format/oct_store.h), then one
+ * deterministic serialization (bases and CRCs computed at finish; the
+ * spools' CRCs are kept as their bytes come). */
 #include "format/oct.h"
 #include "format/oct_layout.h"
 #include "format/oct_sink.h"
@@ -18,7 +18,7 @@ struct oct_writer {
     float palette[OCT_MAX_SURFACES * 3];
     oct_chunks masks[OCT_MAX_LEVELS]; /* a byte a node: its count is the depth's node count */
     oct_spool voxels;     /* 4 bytes a voxel (little-endian host); none with OCT_FLAG_SHELL_ONLY */
-    oct_chunks surfaces;  /* a byte a voxel, with more than one surface */
+    oct_spool surfaces;   /* a byte a voxel, with more than one surface */
     size_t voxel_count;
     unsigned char *function; /* copy of the FUNCTION section, or NULL */
     int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
@@ -83,7 +83,11 @@ oct_err oct_writer_create(const oct_writer_params *p, oct_writer **out)
         w->p.function = w->function;
     }
     w->v11 = p->flags || p->function || p->shard_count;
-    oct_spool_open(&w->voxels, (p->flags & OCT_FLAG_SHELL_ONLY) ? NULL : p->spool_dir);
+    /* the scratch files' share of half the free space: a byte a voxel of
+     * surface indices for every four of records */
+    const int recs = !(p->flags & OCT_FLAG_SHELL_ONLY), idx = p->surface_count > 1;
+    oct_spool_open(&w->voxels, recs ? p->spool_dir : NULL, idx ? 4 : 1, idx ? 5 : 1);
+    oct_spool_open(&w->surfaces, idx ? p->spool_dir : NULL, 1, recs ? 5 : 1);
     w->p.spool_dir = NULL; /* (not kept: only the open needs it) */
     for (uint32_t i = 0; i < 3 * p->surface_count; i++)
         w->palette[i] = p->palette ? p->palette[i] : 0.8f;
@@ -118,11 +122,11 @@ oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8
         return OCT_ENOMEM;
     /* the surfaces first: when the voxels then fail, the surfaces appended
        are taken back, so that the next call retries from the same state */
-    const size_t ns = w->surfaces.n;
-    if (w->p.surface_count > 1 && oct_chunks_append(&w->surfaces, surfaces, n) != 0)
+    const oct_spool_mark ms = oct_spool_tell(&w->surfaces);
+    if (w->p.surface_count > 1 && oct_spool_append(&w->surfaces, surfaces, n) != 0)
         return OCT_ENOMEM;
     if (!shell && oct_spool_append(&w->voxels, voxels, n * sizeof *voxels) != 0) {
-        w->surfaces.n = ns;
+        oct_spool_rewind(&w->surfaces, ms);
         return OCT_ENOMEM;
     }
     w->voxel_count += n;
@@ -183,7 +187,7 @@ static int put_section(const oct_writer *w, int k, oct_sink *s)
     case OCT_SEC_VOXELS: /* little-endian host; nothing with OCT_FLAG_SHELL_ONLY */
         return oct_spool_put(&w->voxels, s);
     case OCT_SEC_SURFACES:
-        return w->p.surface_count > 1 ? oct_chunks_put(&w->surfaces, s) : 0;
+        return oct_spool_put(&w->surfaces, s); /* (empty with one surface) */
     case OCT_SEC_PALETTE:
         return oct_sink_put(s, w->palette, (size_t)w->p.surface_count * 3 * sizeof(float));
     default:
@@ -280,8 +284,9 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             lay.off[k] = oct_align_up(end);
             end = lay.off[k] + size;
         }
-        if (k == OCT_SEC_VOXELS) { /* kept as they came: not read back twice */
-            lay.crc[k] = oct_spool_crc(&w->voxels);
+        /* the spools' CRCs were kept as their bytes came: not read back twice */
+        if (k == OCT_SEC_VOXELS || k == OCT_SEC_SURFACES) {
+            lay.crc[k] = oct_spool_crc(k == OCT_SEC_VOXELS ? &w->voxels : &w->surfaces);
             continue;
         }
         oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0, 0};
@@ -319,7 +324,7 @@ void oct_writer_free(oct_writer *w)
     for (int d = 0; d < OCT_MAX_LEVELS; d++)
         oct_chunks_free(&w->masks[d]);
     oct_spool_free(&w->voxels);
-    oct_chunks_free(&w->surfaces);
+    oct_spool_free(&w->surfaces);
     free(w->function);
     free(w);
 }

@@ -59,9 +59,9 @@ static const char help_text[] =
     "  -h, --help             this text\n"
     "  --version              print the version and exit\n"
     "\n"
-    "Until the end the voxel records wait in an unlinked scratch file in $TMPDIR\n"
-    "(default /tmp; at most half its free space), or in memory where none can be\n"
-    "made; the output is the same.\n"
+    "Until the end the voxel records (and with several surfaces their surface\n"
+    "indices) wait in unlinked scratch files in $TMPDIR (default /tmp; at most half\n"
+    "its free space), or in memory where none can be made; the output is the same.\n"
     "\n"
     "Exit status: 0 success, 1 run-time failure, 2 bad usage.\n";
 
@@ -308,7 +308,8 @@ static int rasterize_scene(const options *o)
     }
     wp.function = function;
     wp.flags = o->shell_only ? OCT_FLAG_SHELL_ONLY : 0;
-    /* the voxel records wait in a scratch file, not in memory (README) */
+    /* the voxel records and surface indices wait in scratch files, not in
+     * memory (README) */
     const char *tmpdir = getenv("TMPDIR");
     wp.spool_dir = tmpdir && *tmpdir ? tmpdir : "/tmp";
     if (bp.shard) { /* the shard's place in its partition, for --merge and --info */

@@ -349,8 +349,19 @@ static void test_spooled_records(void **state)
     test_tree_free(&t);
 }
 
+/* The bytes of a spool read back into memory (oct_spool_put). */
+static unsigned char *spool_bytes(const oct_spool *s, size_t *len)
+{
+    char *mem = NULL;
+    FILE *f = open_memstream(&mem, len);
+    oct_sink sink = {f, 0, 0, 1};
+    assert_int_equal(oct_spool_put(s, &sink), 0);
+    fclose(f);
+    return (unsigned char *)mem;
+}
+
 /* The scratch file takes at most half the space that was free where it
- * was made; past its cap the bytes go to memory, and all come back in order
+ * was made (its share of that half, when spools are opened together); past its cap the bytes go to memory, and all come back in order
  * with the CRC of what was appended. */
 static void test_spool_leaves_room(void **state)
 {
@@ -360,7 +371,7 @@ static void test_spool_leaves_room(void **state)
     struct statvfs before, after;
     assert_int_equal(statvfs(dir, &before), 0);
     oct_spool s;
-    oct_spool_open(&s, dir);
+    oct_spool_open(&s, dir, 1, 1);
     assert_int_equal(statvfs(dir, &after), 0);
     assert_true(s.has_file);
     const uint64_t a = (uint64_t)before.f_bavail * before.f_frsize / 2,
@@ -368,6 +379,13 @@ static void test_spool_leaves_room(void **state)
     const uint64_t slack = (uint64_t)64 << 20; /* other writers to the same disk */
     assert_true(s.file_cap + slack >= (a < b ? a : b));
     assert_true(s.file_cap <= (a > b ? a : b) + slack);
+    /* spools opened together split it: a fifth of it here */
+    oct_spool fifth;
+    oct_spool_open(&fifth, dir, 1, 5);
+    assert_true(fifth.has_file);
+    assert_true(fifth.file_cap + slack >= (a < b ? a : b) / 5);
+    assert_true(fifth.file_cap <= (a > b ? a : b) / 5 + slack);
+    oct_spool_free(&fifth);
     s.file_cap = 1000; /* a nearly full disk */
     unsigned char bytes[3000];
     for (size_t i = 0; i < sizeof bytes; i++)
@@ -377,16 +395,57 @@ static void test_spool_leaves_room(void **state)
     assert_int_equal(s.on_disk, 1000);
     assert_int_equal(s.mem.n, 2000);
     assert_int_equal(oct_spool_crc(&s), (uint32_t)crc32_z(0, bytes, sizeof bytes));
-    char *mem = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&mem, &len);
-    oct_sink sink = {f, 0, 0, 1};
-    assert_int_equal(oct_spool_put(&s, &sink), 0);
-    fclose(f);
+    size_t len;
+    unsigned char *mem = spool_bytes(&s, &len);
     assert_int_equal(len, sizeof bytes);
     assert_memory_equal(mem, bytes, sizeof bytes);
     free(mem);
     oct_spool_free(&s);
+    assert_int_equal(dir_entries(dir), 0);
+    assert_int_equal(rmdir(dir), 0);
+}
+
+/* A spool rewound to a mark comes back as the bytes before the mark and
+ * those appended after the rewind, with their CRC, whether the bytes
+ * dropped were in the file, across the file's cap or in memory, and
+ * without a file at all (the writer's all-or-nothing append of the
+ * surface indices and the records). */
+static void test_spool_rewind(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/oct-spool-test-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    unsigned char bytes[3000];
+    for (size_t i = 0; i < sizeof bytes; i++)
+        bytes[i] = (unsigned char)(i * 13 + (i >> 7));
+    for (int with_file = 0; with_file <= 1; with_file++) {
+        oct_spool s;
+        oct_spool_open(&s, with_file ? dir : NULL, 1, 1);
+        assert_int_equal(s.has_file, with_file);
+        s.file_cap = 1000;
+        assert_int_equal(oct_spool_append(&s, bytes, 600), 0); /* (in the file) */
+        oct_spool_mark m = oct_spool_tell(&s);
+        assert_int_equal(oct_spool_append(&s, bytes + 600, 700), 0); /* across the cap */
+        oct_spool_rewind(&s, m);
+        assert_int_equal(oct_spool_size(&s), 600);
+        assert_int_equal(oct_spool_append(&s, bytes + 1300, 500), 0); /* memory: the file refused */
+        m = oct_spool_tell(&s);
+        assert_int_equal(oct_spool_append(&s, bytes + 1800, 900), 0);
+        oct_spool_rewind(&s, m);
+        assert_int_equal(oct_spool_append(&s, bytes + 2700, 300), 0);
+        assert_int_equal(s.on_disk, with_file ? 600 : 0);
+        unsigned char want[1400];
+        memcpy(want, bytes, 600);
+        memcpy(want + 600, bytes + 1300, 500);
+        memcpy(want + 1100, bytes + 2700, 300);
+        assert_int_equal(oct_spool_crc(&s), (uint32_t)crc32_z(0, want, sizeof want));
+        size_t len;
+        unsigned char *got = spool_bytes(&s, &len);
+        assert_int_equal(len, sizeof want);
+        assert_memory_equal(got, want, sizeof want);
+        free(got);
+        oct_spool_free(&s);
+    }
     assert_int_equal(dir_entries(dir), 0);
     assert_int_equal(rmdir(dir), 0);
 }
@@ -400,6 +459,7 @@ int main(void)
         cmocka_unit_test(test_large_tree_spans_chunks),
         cmocka_unit_test(test_spooled_records),
         cmocka_unit_test(test_spool_leaves_room),
+        cmocka_unit_test(test_spool_rewind),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -78,6 +78,16 @@ TMPDIR="$T/none" "$BIN/rasterize" "$T/s2.scene" -o "$T/t4.oct" --levels 7 -q || 
 cmp -s "$T/t1.oct" "$T/t3.oct" || fail "the spool changed the output"
 cmp -s "$T/t1.oct" "$T/t4.oct" || fail "the memory fallback changed the output"
 [ -z "$(ls -A "$T/spool")" ] || fail "scratch file left in TMPDIR"
+# (with several surfaces their indices wait there too; --shell-only keeps
+# only those)
+for flag in "" --shell-only; do
+    "$BIN/rasterize" "$ROOT/scenes/multi.scene" -o "$T/m1.oct" --levels 7 -q $flag \
+        || fail "multi $flag"
+    TMPDIR="$T/spool" "$BIN/rasterize" "$ROOT/scenes/multi.scene" -o "$T/m2.oct" --levels 7 -q \
+        $flag || fail "multi $flag: spooled"
+    cmp -s "$T/m1.oct" "$T/m2.oct" || fail "multi $flag: the spool changed the output"
+done
+[ -z "$(ls -A "$T/spool")" ] || fail "scratch file left in TMPDIR (several surfaces)"
 
 # ... and whatever build of the lane evaluators runs (AVX2 where the
 # processor has it, or the portable one): levels 8, where the voxels'
