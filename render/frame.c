@@ -404,6 +404,19 @@ static void exact_workers_free(frame_keep *k)
     k->exact_scene = NULL;
 }
 
+/* The exact workers' counters summed: voxel tests, of them by bisection,
+ * voxels passed, hits past their voxel. */
+static void exact_counts(const frame_keep *k, uint64_t c[4])
+{
+    c[0] = c[1] = c[2] = c[3] = 0;
+    for (unsigned i = 0; k->exact && i < k->exact_n; i++) {
+        c[0] += k->exact[i].fast + k->exact[i].slow;
+        c[1] += k->exact[i].slow;
+        c[2] += k->exact[i].skipped;
+        c[3] += k->exact[i].beyond;
+    }
+}
+
 /* One exact worker for each thread of a pass: those kept in k for the same
  * scene and as many threads, else made anew (and kept there); 0, or -1
  * when they cannot be had. */
@@ -529,12 +542,19 @@ int frame_render(const frame_job *job, frame_stats *stats)
             rc = ENOMEM; /* one ray a pixel */
         }
     }
+    uint64_t x0[4], x1[4]; /* (the workers count across the frames they are kept) */
+    exact_counts(keep, x0);
     int rc1 = run_pass(&sh, 0);
     if (sh.border && !atomic_load(&sy.changed)) {
         int rc2 = run_pass(&sh, 1);
         if (!rc1)
             rc1 = rc2;
     }
+    exact_counts(keep, x1);
+    stats->exact_tests = x1[0] - x0[0];
+    stats->exact_bisected = x1[1] - x0[1];
+    stats->exact_passed = x1[2] - x0[2];
+    stats->exact_beyond = x1[3] - x0[3];
     frame_keep_free(&own);
     pthread_mutex_destroy(&sy.lock);
     stats->rays = (uint64_t)npx + sy.sum.rays;

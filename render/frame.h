@@ -91,6 +91,11 @@ typedef struct frame_stats {
                                         pass's time but its secondary rays') */
     double shadow_ns, ao_ns;         /* secondary_ns in two (a hit's shared start
                                         counts as its shadow ray's when it has one) */
+    /* --exact: the occupied voxels the rays reached, tested for a root (of
+     * them by interval bisection, the certified path undecided) or passed
+     * inside a span certified root-free; the hits placed past the voxel
+     * tested (exact_scene.h) */
+    uint64_t exact_tests, exact_bisected, exact_passed, exact_beyond;
     int file_changed; /* the mapped file changed under a thread (map_guard.h): image incomplete */
 } frame_stats;
 

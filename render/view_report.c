@@ -1,6 +1,7 @@
 /* view_report: render's per-view line (view_report.h). */
 #include "render/view_report.h"
 
+#include <inttypes.h>
 #include <stdio.h>
 
 /* " N Mrays R Mrays/s" of one kind of ray: n rays in ns of thread time
@@ -44,6 +45,11 @@ void view_report(const views_view *v, const frame_stats *st, double ms, int verb
             fprintf(stderr, ", ao");
             report_kind((double)st->ao_rays, st->ao_ns, th);
         }
+        if (st->exact_tests || st->exact_passed)
+            fprintf(stderr,
+                    "; exact: %" PRIu64 " voxel tests (%" PRIu64 " by bisection), %" PRIu64
+                    " voxels passed root-free, %" PRIu64 " hits past their voxel",
+                    st->exact_tests, st->exact_bisected, st->exact_passed, st->exact_beyond);
     }
     fputc('\n', stderr);
 }

@@ -38,6 +38,13 @@ printf -- '-o %s %s --exact\n' "$T/w.png" "$V" > "$T/views2"
 expect_exit 0 "$BIN/render" "$T/shell.oct" --views "$T/views2" -q
 [ -s "$T/w.png" ] || fail "views --exact on a shell-only file"
 
+# -v with --exact: the exact test's counts, some voxels tested; none without
+expect_exit 0 "$BIN/render" "$T/full.oct" -o "$T/v.png" $V --exact -v
+grep -q '; exact: [1-9][0-9]* voxel tests ([0-9]* by bisection), [0-9]* voxels passed root-free, [0-9]* hits past their voxel$' "$ERR" \
+    || fail "-v --exact lacks the exact test's counts"
+expect_exit 0 "$BIN/render" "$T/full.oct" -o "$T/v.png" $V -v
+grep -q 'exact:' "$ERR" && fail "-v without --exact reports exact counts"
+
 # A 1.0 file has no stored function.
 OLD="$ROOT/tests/fuzz/corpus/fuzz_oct/ok-l4-v2.oct"
 expect_exit 0 "$BIN/render" --info "$OLD"
