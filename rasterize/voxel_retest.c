@@ -187,9 +187,11 @@ void batch_retests(worker *wk, unsigned pidx, leaf_parent *lp, unsigned nb)
                 }
                 it[nit++] = r;
             }
-    centred_form_drops(wk, t, G, fit, nfd, fdrop);
-    for (unsigned j = 0; j < nfd; j++)
-        drop[fdj[j]] = fdrop[j];
+    if (nfd) { /* (the guard also shows GCC that fit is written before it is read) */
+        centred_form_drops(wk, t, G, fit, nfd, fdrop);
+        for (unsigned j = 0; j < nfd; j++)
+            drop[fdj[j]] = fdrop[j];
+    }
     for (unsigned j = 0; j < nit; j++) {
         if (drop[j]) {
             lp[it_lp[j]].centred[0] |= (uint8_t)(1u << it_ch[j]);
