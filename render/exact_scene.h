@@ -1,8 +1,9 @@
 /* exact_scene: a tree's surface functions prepared for `render --exact`:
  * per occupied coarse cell (the tree's nodes of one depth), the surfaces
  * that can be present there, each with its tape pruned for that cell
- * (tape_prune_const), so a voxel is never tested with a whole long tape;
- * and the exact hit test in one voxel (RENDER.md, "--exact"). */
+ * (tape_prune_const), so a voxel is never tested with a whole long tape
+ * (exact_scene.c); and the exact hit test in one voxel (exact_voxel.c;
+ * RENDER.md, "--exact"). */
 #ifndef EXACT_SCENE_H
 #define EXACT_SCENE_H
 

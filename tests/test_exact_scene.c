@@ -271,7 +271,7 @@ static void test_roots_on_faces(void **state)
  * mostly use it
  * (tape_err_cell), few models that it cannot decide are decided by the
  * per-point one, a quarter of the hits at least are placed past the voxel
- * whose span was tested (root_beyond in exact_scene.c), and some voxels are
+ * whose span was tested (root_beyond in exact_voxel.c), and some voxels are
  * passed untested inside spans it certified root-free. */
 static void fast_vs_fallback(const char *text, const double target[3], double min_fast,
                              int bounded)
@@ -285,7 +285,7 @@ static void fast_vs_fallback(const char *text, const double target[3], double mi
     memcpy(off.cand, b.es.cand, b.es.ncand * sizeof *off.cand);
     for (uint32_t k = 0; k < off.ncand; k++)
         for (int e = 0; e < 6; e++)
-            off.cand[k].hmag[e] = INFINITY;
+            off.cand[k].hmag[e] = off.cand[k].hbranch[e] = INFINITY;
     exact_worker w1, w2;
     assert_int_equal(exact_worker_init(&w1, &b.es), 0);
     assert_int_equal(exact_worker_init(&w2, &off), 0);
@@ -400,6 +400,12 @@ static void test_fast_vs_fallback(void **state)
     fast_vs_fallback("bounds -1.3 -1.3 -1.3 1.3 1.3 1.3\n"
                      "surface (x^2 + y^2 + z^2 + 0.6^2 - 0.25^2)^2 - 4*0.6^2*(x^2 + y^2)\n",
                      centre, 0.9, 1);
+    /* a kink off the surface in most cells (|G| = 0.3: G's zero set a few
+     * voxels away), no sub-cells: the bound with the kinks allowed on spans
+     * where the kink is decided (branch_test) */
+    fast_vs_fallback("bounds -1 -1 -1 1 1 1\nsurface abs(sin(4*x)*cos(4*y) + sin(4*y)*cos(4*z)"
+                     " + sin(4*z)*cos(4*x)) - 0.3\n",
+                     centre, 0.7, 0);
     /* creases: the sub-cells along them keep the fallback */
     fast_vs_fallback("bounds -1.1 -1.1 -1.1 1.1 1.1 1.1\n"
                      "surface max(max(abs(x), abs(y), abs(z)) - 0.8, x^2 + y^2 + z^2 - 1.0,"
