@@ -361,8 +361,9 @@ static unsigned char *spool_bytes(const oct_spool *s, size_t *len)
 }
 
 /* The scratch file takes at most half the space that was free where it
- * was made (its share of that half, when spools are opened together); past its cap the bytes go to memory, and all come back in order
- * with the CRC of what was appended. */
+ * was made (its share of that half, when spools are opened together); past
+ * its cap the bytes go to memory, and all come back in order with the CRC
+ * of what was appended. */
 static void test_spool_leaves_room(void **state)
 {
     (void)state;
@@ -423,12 +424,13 @@ static void test_spool_rewind(void **state)
         oct_spool_open(&s, with_file ? dir : NULL, 1, 1);
         assert_int_equal(s.has_file, with_file);
         s.file_cap = 1000;
-        assert_int_equal(oct_spool_append(&s, bytes, 600), 0); /* (in the file) */
+        assert_int_equal(oct_spool_append(&s, bytes, 600), 0); /* (in the file, if any) */
         oct_spool_mark m = oct_spool_tell(&s);
         assert_int_equal(oct_spool_append(&s, bytes + 600, 700), 0); /* across the cap */
         oct_spool_rewind(&s, m);
         assert_int_equal(oct_spool_size(&s), 600);
-        assert_int_equal(oct_spool_append(&s, bytes + 1300, 500), 0); /* memory: the file refused */
+        /* in memory: the file refused bytes */
+        assert_int_equal(oct_spool_append(&s, bytes + 1300, 500), 0);
         m = oct_spool_tell(&s);
         assert_int_equal(oct_spool_append(&s, bytes + 1800, 900), 0);
         oct_spool_rewind(&s, m);
