@@ -160,6 +160,19 @@ static double near_end(const trace_ray *r, double b)
     return b + BEYOND_NEAR / dm;
 }
 
+/* The answer about a span [a, end] past the voxel tested: a root there is
+ * the ray's hit (counted), a span certified root-free is kept for the
+ * ray's next voxels (clear_to); else the voxel's own answer, no root. */
+static int past_answer(exact_worker *w, int st, double end)
+{
+    if (st == EXACT_FAST_NONE)
+        w->clear_to = end;
+    if (st != EXACT_FAST_ROOT)
+        return EXACT_FAST_NONE;
+    w->beyond++;
+    return EXACT_FAST_ROOT;
+}
+
 static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t c[3], unsigned shift,
                        uint64_t key, const tape *t_exact, double a, double b, double curv,
                        double *t, double grad[3])
@@ -175,12 +188,7 @@ static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t c[3],
         e = near;
         st = exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad);
     }
-    if (st == EXACT_FAST_NONE)
-        w->clear_to = e;
-    if (st != EXACT_FAST_ROOT)
-        return EXACT_FAST_NONE;
-    w->beyond++;
-    return EXACT_FAST_ROOT;
+    return past_answer(w, st, e);
 }
 
 /* Candidate c of a coarse cell where its tape keeps a kink (hmag +inf) and
@@ -211,8 +219,11 @@ static int branch_test(exact_worker *w, const trace_ray *r, const exact_cand *c,
         end = near < e ? near : e;
     }
     interval box[3];
-    exact_segment_box(l, a, end, box);
-    int past_ok = end > b && !tape_hess_kinks(&c->t, box, w->scratch.islots);
+    int past_ok = 0;
+    if (end > b) {
+        exact_segment_box(l, a, end, box);
+        past_ok = !tape_hess_kinks(&c->t, box, w->scratch.islots);
+    }
     if (!past_ok) {
         exact_segment_box(l, a, b, box);
         if (tape_hess_kinks(&c->t, box, w->scratch.islots))
@@ -225,13 +236,8 @@ static int branch_test(exact_worker *w, const trace_ray *r, const exact_cand *c,
         exact_fast_root(&c->t, &w->scratch, l, a, b, curv, NULL, NAN, &md, &have, t, grad);
     if (st != EXACT_FAST_NONE || !past_ok || !have)
         return st;
-    const int past = exact_fast_decide(&c->t, &w->scratch, l, a, end, curv, &md, t, grad);
-    if (past == EXACT_FAST_NONE)
-        w->clear_to = end;
-    if (past != EXACT_FAST_ROOT)
-        return st;
-    w->beyond++;
-    return past;
+    return past_answer(w, exact_fast_decide(&c->t, &w->scratch, l, a, end, curv, &md, t, grad),
+                       end);
 }
 
 /* Where the ray meets voxel n's stored plane (the paper's hit), clamped

@@ -349,15 +349,20 @@ static void test_spooled_records(void **state)
     test_tree_free(&t);
 }
 
-/* The bytes of a spool read back into memory (oct_spool_put). */
-static unsigned char *spool_bytes(const oct_spool *s, size_t *len)
+/* The spool holds exactly the n bytes want: its CRC, and read back
+ * (oct_spool_put). */
+static void assert_spool_holds(const oct_spool *s, const unsigned char *want, size_t n)
 {
+    assert_int_equal(oct_spool_crc(s), (uint32_t)crc32_z(0, want, n));
     char *mem = NULL;
-    FILE *f = open_memstream(&mem, len);
+    size_t len = 0;
+    FILE *f = open_memstream(&mem, &len);
     oct_sink sink = {f, 0, 0, 1};
     assert_int_equal(oct_spool_put(s, &sink), 0);
     fclose(f);
-    return (unsigned char *)mem;
+    assert_int_equal(len, n);
+    assert_memory_equal(mem, want, n);
+    free(mem);
 }
 
 /* The scratch file takes at most half the space that was free where it
@@ -395,12 +400,7 @@ static void test_spool_leaves_room(void **state)
         assert_int_equal(oct_spool_append(&s, bytes + i, sizeof bytes - i < 700 ? sizeof bytes - i : 700), 0);
     assert_int_equal(s.on_disk, 1000);
     assert_int_equal(s.mem.n, 2000);
-    assert_int_equal(oct_spool_crc(&s), (uint32_t)crc32_z(0, bytes, sizeof bytes));
-    size_t len;
-    unsigned char *mem = spool_bytes(&s, &len);
-    assert_int_equal(len, sizeof bytes);
-    assert_memory_equal(mem, bytes, sizeof bytes);
-    free(mem);
+    assert_spool_holds(&s, bytes, sizeof bytes);
     oct_spool_free(&s);
     assert_int_equal(dir_entries(dir), 0);
     assert_int_equal(rmdir(dir), 0);
@@ -440,12 +440,7 @@ static void test_spool_rewind(void **state)
         memcpy(want, bytes, 600);
         memcpy(want + 600, bytes + 1300, 500);
         memcpy(want + 1100, bytes + 2700, 300);
-        assert_int_equal(oct_spool_crc(&s), (uint32_t)crc32_z(0, want, sizeof want));
-        size_t len;
-        unsigned char *got = spool_bytes(&s, &len);
-        assert_int_equal(len, sizeof want);
-        assert_memory_equal(got, want, sizeof want);
-        free(got);
+        assert_spool_holds(&s, want, sizeof want);
         oct_spool_free(&s);
     }
     assert_int_equal(dir_entries(dir), 0);
