@@ -1,7 +1,7 @@
 /* tape_dir_body.h: forward-mode AD in double with N tangents, the rules of
  * tape_eval_grad (abs, min, max: the branch taken), included by
- * tape_eval_dir.c once per N with FN its name and SLOT its slot type (v,
- * d[N]). seed[k] is the tangent of coordinate k; every tangent follows the
+ * tape_eval_dir.c once per N with FN its name, SLOT its slot type (v,
+ * d[N]) and LEAF(slot, v, d) the store of a leaf's whole slot. seed[k] is the tangent of coordinate k; every tangent follows the
  * same operations, so one tangent seeded with a direction is, bit for bit,
  * the same whatever the others are. */
 #define OP TAPE_OPL
@@ -11,17 +11,17 @@ static inline double FN(const tape *t, const double p[3], const double seed[3][N
 {
     const tape_insn *in = t->insn;
     const tape_const *k = t->konst;
+    static const double zero[N] = {0.0};
     for (uint32_t i = 0, n = t->n; i < n; i++) {
         SLOT *r = &s[i];
         /* operands: only the ops that have them name them (as tape_eval) */
 #define OA s[in[i].a]
 #define OC s[in[i].b]
         TAPE_DISPATCH(in[i].op) {
-        OP(CONST): r->v = k[in[i].a].v; TANGENTS r->d[j] = 0.0; continue;
+        OP(CONST): LEAF(r, k[in[i].a].v, zero); continue;
         OP(X): OP(Y): OP(Z): {
             const uint32_t ax = in[i].op - TAPE_X;
-            r->v = p[ax];
-            TANGENTS r->d[j] = seed[ax][j];
+            LEAF(r, p[ax], seed[ax]);
             continue;
         }
         OP(NEG): r->v = -OA.v; TANGENTS r->d[j] = -OA.d[j]; continue;

@@ -7,19 +7,56 @@
 #include "common/expr/exp_kernel.h"
 #include "common/expr/tape_int.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+/* A leaf's slot (a variable's, a constant's) written whole, in the shape
+ * in which GCC's code for the ops loads slots: (v, d[0]) as one 16-byte
+ * vector with one tangent, v alone and the tangents in pairs with four. A
+ * slot written in parts and read by a wider load cannot be forwarded from
+ * the store buffer: the load waits for the stores to retire, and each
+ * variable's first use paid that (docs/perf-log.md). */
+static inline void leaf_dir1(tape_dir1 *r, double v, const double d[1])
+{
+#if defined(__SSE2__)
+    _mm_storeu_pd(&r->v, _mm_set_pd(d[0], v));
+#else
+    r->v = v;
+    r->d[0] = d[0];
+#endif
+}
+
+static inline void leaf_dir4(tape_dir4 *r, double v, const double d[4])
+{
+#if defined(__SSE2__)
+    _mm_store_sd(&r->v, _mm_set_sd(v));
+    _mm_storeu_pd(&r->d[0], _mm_loadu_pd(d));
+    _mm_storeu_pd(&r->d[2], _mm_loadu_pd(d + 2));
+#else
+    r->v = v;
+    for (int j = 0; j < 4; j++)
+        r->d[j] = d[j];
+#endif
+}
+
 #define N 1
+#define LEAF leaf_dir1
 #define FN eval_dir1
 #define SLOT tape_dir1
 #include "common/expr/tape_dir_body.h"
 #undef N
+#undef LEAF
 #undef FN
 #undef SLOT
 
 #define N 4
+#define LEAF leaf_dir4
 #define FN eval_dir4
 #define SLOT tape_dir4
 #include "common/expr/tape_dir_body.h"
 #undef N
+#undef LEAF
 #undef FN
 #undef SLOT
 
