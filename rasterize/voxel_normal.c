@@ -34,15 +34,20 @@ static void newton_start(newton *nw, const double centre[3], const double fg_cen
 }
 
 /* The Newton step from p (f and grad f there: f, g), kept inside the voxel
- * (box), into q; 0 when it cannot be taken (q untouched). */
+ * (box), into q, and the step q - p into dq; 0 when it cannot be taken (q
+ * and dq untouched). (dq is made here, from q in registers: read back from
+ * q's three stores as one vector load, the stores would not be forwarded
+ * and the load would wait for them to retire; docs/perf-log.md.) */
 static inline int newton_step(const double p[3], double f, const double g[3],
-                              const interval box[3], double q[3])
+                              const interval box[3], double q[3], double dq[3])
 {
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(g2 > 0.0) || !isfinite(g2) || !isfinite(f) || f == 0.0)
         return 0;
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
         q[k] = min2(max2(p[k] - f / g2 * g[k], box[k].lo), box[k].hi); /* NaN gives lo */
+        dq[k] = q[k] - p[k];
+    }
     return 1;
 }
 
@@ -50,14 +55,14 @@ static inline int newton_step(const double p[3], double f, const double g[3],
  * and they are wanted at the new one, 0 when the iteration has stopped. */
 static int newton_advance(newton *nw, const interval box[3], double h)
 {
-    double q[3];
+    double q[3], dq[3];
     if (nw->step == NEWTON_STEPS)
         return 0;
-    if (!newton_step(nw->p, nw->f, nw->g, box, q))
+    if (!newton_step(nw->p, nw->f, nw->g, box, q, dq))
         return 0; /* no step */
     double moved = 0.0; /* max norm */
     for (int k = 0; k < 3; k++)
-        moved = max2(moved, fabs(q[k] - nw->p[k]));
+        moved = max2(moved, fabs(dq[k]));
     if (moved < NEWTON_TOL * h)
         return 0; /* the linearisation at p places the surface well enough */
     memcpy(nw->p, q, sizeof q);
@@ -245,12 +250,12 @@ static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
                              const interval box[3], double h, const double H[3][3])
 {
     const double f0 = fg[0], *g0 = fg + 1;
-    double p[3];
-    if (!newton_step(c, f0, g0, box, p))
+    double p[3], d[3];
+    if (!newton_step(c, f0, g0, box, p, d)) {
         memcpy(p, c, sizeof p); /* no step: the model at c itself */
-    double d[3], Hd[3], f = f0, g[3]; /* the model at p */
-    for (int k = 0; k < 3; k++)
-        d[k] = p[k] - c[k];
+        d[0] = d[1] = d[2] = 0.0;
+    }
+    double Hd[3], f = f0, g[3]; /* the model at p */
     for (int r = 0; r < 3; r++) {
         Hd[r] = H[r][0] * d[0] + H[r][1] * d[1] + H[r][2] * d[2];
         f += g0[r] * d[r];
