@@ -6,8 +6,9 @@
 
 #include <stdint.h>
 
-/* Unit vector -> 24-bit octahedral code (12 bits a coordinate, rounded to
- * nearest). A zero or non-finite vector encodes +z. */
+/* Direction -> 24-bit octahedral code (12 bits a coordinate, rounded to
+ * nearest): the vector need not be unit, its L1 norm is divided out. A
+ * zero or non-finite vector encodes +z. */
 uint32_t oct_normal_encode(const double n[3]);
 
 /* 24-bit code -> unit vector (renormalised, in float). */

@@ -90,17 +90,20 @@ static uint32_t record_at(worker *wk, const double p[3], double f, const double 
         if (!isfinite(f))
             f = 0.0;
     }
-    double len = sqrt(g2), n[3], d = 0.0;
-    for (int k = 0; k < 3; k++) {
-        n[k] = g[k] / len;
-        double s = q[k] - f / g2 * g[k]; /* surface point of the linearisation */
-        d += n[k] * (s - centre[k]);
-    }
-    d /= h;
+    /* The offset: the linearisation's zero set {x : f + g . (x - q) = 0}
+     * lies at signed distance (g . (q - centre) - f) / |g| from the centre
+     * along n = g / |g|. One sqrt and one division on the way to it, and
+     * the octahedral code takes g as it is (it is scale-free): the chain of
+     * dependent divisions this replaces was most of the record's time
+     * (docs/perf-log.md). */
+    double s = -f;
+    for (int k = 0; k < 3; k++)
+        s += g[k] * (q[k] - centre[k]);
+    double d = s / (sqrt(g2) * h);
     if (!isfinite(d))
         d = 0.0;
     d = min2(max2(d, -HALF_DIAGONAL), HALF_DIAGONAL);
-    return oct_voxel_pack(n, d);
+    return oct_voxel_pack(g, d);
 }
 
 /* The voxel's record from where the iteration stopped. */
