@@ -70,10 +70,22 @@ static int newton_advance(newton *nw, const interval box[3], double h)
     return 1;
 }
 
-/* The voxel's record from an iterate p with f and grad f there (f, g); the
- * centre's values fg are the fallback where those fail. */
-static uint32_t record_at(worker *wk, const double p[3], double f, const double gi[3],
-                          const double fg[4], const double centre[3], double h)
+/* What a voxel's record is packed from: the normal's direction g (not
+ * unit) with g2 = |g|^2 > 0, and s, the offset's numerator (record_pack).
+ * The records of a batch are made in two passes, these first, then each
+ * packed: the packing's sqrt and division, dependent on each other, would
+ * otherwise hold up each voxel in turn (docs/perf-log.md). */
+typedef struct record_in {
+    double g[3], g2, s;
+} record_in;
+
+/* The voxel's record_in from an iterate p with f and grad f there (f, g);
+ * the centre's values fg are the fallback where those fail, +z with offset 0
+ * where those fail too (counted in normal_fallbacks). The linearisation's
+ * zero set {x : f + g . (x - q) = 0} lies at signed distance
+ * (g . (q - centre) - f) / |g| from the centre along g / |g|. */
+static void record_in_at(worker *wk, const double p[3], double f, const double gi[3],
+                         const double fg[4], const double centre[3], record_in *ri)
 {
     const double *q = p, *g = gi;
     double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
@@ -84,32 +96,33 @@ static uint32_t record_at(worker *wk, const double p[3], double f, const double 
         g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
         if (!(g2 > 0.0) || !isfinite(g2)) {
             wk->st.normal_fallbacks++;
-            static const double up[3] = {0.0, 0.0, 1.0};
-            return oct_voxel_pack(up, 0.0);
+            *ri = (record_in){{0.0, 0.0, 1.0}, 1.0, 0.0};
+            return;
         }
         if (!isfinite(f))
             f = 0.0;
     }
-    /* The offset: the linearisation's zero set {x : f + g . (x - q) = 0}
-     * lies at signed distance (g . (q - centre) - f) / |g| from the centre
-     * along n = g / |g|. One sqrt and one division on the way to it, and
-     * the octahedral code takes g as it is (it is scale-free): the chain of
-     * dependent divisions this replaces was most of the record's time
-     * (docs/perf-log.md). */
     double s = -f;
     for (int k = 0; k < 3; k++)
         s += g[k] * (q[k] - centre[k]);
-    double d = s / (sqrt(g2) * h);
+    *ri = (record_in){{g[0], g[1], g[2]}, g2, s};
+}
+
+/* The record: the octahedral code of g (scale-free: no division by |g|)
+ * and the offset s / |g| in voxel edges (h), clamped. */
+static uint32_t record_pack(const record_in *ri, double h)
+{
+    double d = ri->s / (sqrt(ri->g2) * h);
     if (!isfinite(d))
         d = 0.0;
     d = min2(max2(d, -HALF_DIAGONAL), HALF_DIAGONAL);
-    return oct_voxel_pack(g, d);
+    return oct_voxel_pack(ri->g, d);
 }
 
-/* The voxel's record from where the iteration stopped. */
-static uint32_t newton_record(worker *wk, const newton *nw, const double centre[3], double h)
+/* The voxel's record_in from where the iteration stopped. */
+static void newton_record(worker *wk, const newton *nw, const double centre[3], record_in *ri)
 {
-    return record_at(wk, nw->p, nw->f, nw->g, nw->fg, centre, h);
+    record_in_at(wk, nw->p, nw->f, nw->g, nw->fg, centre, ri);
 }
 
 unsigned voxel_surface(worker *wk, unsigned idx, const double centre[3], newton *nw)
@@ -173,7 +186,9 @@ int emit_voxel(worker *wk, const interval box[3], const double centre[3])
         nw.f = tape_eval_grad(t, nw.p, nw.g, wk->dslots);
         wk->st.point_evals++;
     }
-    return push_voxel(wk, newton_record(wk, &nw, centre, h), best);
+    record_in ri;
+    newton_record(wk, &nw, centre, &ri);
+    return push_voxel(wk, record_pack(&ri, h), best);
 }
 
 /* The finite-difference columns of a leaf-parent's Hessian, from the
@@ -249,8 +264,8 @@ static int leaf_hessian(const double D[3][3], unsigned axes, const double (*B)[3
  * model about c, without evaluating them, and the record from those. Over a
  * voxel the model's error is third order in its size, below what more
  * Newton steps would correct (docs/perf-log.md, rasterize). */
-static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
-                             const interval box[3], double h, const double H[3][3])
+static void model_record(worker *wk, const double c[3], const double fg[4],
+                         const interval box[3], const double H[3][3], record_in *ri)
 {
     const double f0 = fg[0], *g0 = fg + 1;
     double p[3], d[3];
@@ -266,7 +281,7 @@ static uint32_t model_record(worker *wk, const double c[3], const double fg[4],
     f += 0.5 * (d[0] * Hd[0] + d[1] * Hd[1] + d[2] * Hd[2]);
     for (int r = 0; r < 3; r++)
         g[r] = g0[r] + Hd[r];
-    return record_at(wk, p, f, g, fg, c, h);
+    record_in_at(wk, p, f, g, fg, c, ri);
 }
 
 #define ROUND_MAX 64 /* voxels of a leaf_batch: 8 leaf-parents of 8 */
@@ -322,7 +337,7 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
     }
     double H[3][3];
     int hs = -1, have_h = 0; /* the surface H was made for, and whether it could be */
-    uint32_t rec[8];
+    record_in ri[8];
     uint8_t modelled[8]; /* the record made from the model, no iteration */
     for (unsigned j = 0; j < np; j++) {
         if ((int)surf[j] != hs) {
@@ -334,8 +349,8 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
         modelled[j] = (uint8_t)have_h;
         live[j] = 0;
         if (have_h)
-            rec[j] = model_record(wk, cb->centre[child[j]], nw[j].fg, cb->box[child[j]], h,
-                                  (const double (*)[3])H);
+            model_record(wk, cb->centre[child[j]], nw[j].fg, cb->box[child[j]],
+                         (const double (*)[3])H, &ri[j]);
         else
             live[j] = (uint8_t)newton_advance(&nw[j], cb->box[child[j]], h);
     }
@@ -356,9 +371,11 @@ void emit_voxels(worker *wk, const child_boxes *cb, const uint8_t *child,
             }
         newton_rounds(wk, &wk->rec[s], w, box, lv, n, h);
     }
+    for (unsigned j = 0; j < np; j++)
+        if (!modelled[j])
+            newton_record(wk, &nw[j], cb->centre[child[j]], &ri[j]);
     for (unsigned j = 0; j < np && !wk->failed; j++)
-        push_voxel(wk, modelled[j] ? rec[j] : newton_record(wk, &nw[j], cb->centre[child[j]], h),
-                   surf[j]);
+        push_voxel(wk, record_pack(&ri[j], h), surf[j]);
 }
 
 /* Squared distance between the centres of two leaf-parents. */
@@ -405,7 +422,7 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
         if (from >= 0)
             have_h[b] = 2 * leaf_hessian(D[b], axes[b], (const double (*)[3])H[from], H[b]);
     }
-    uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
+    record_in ri[ROUND_MAX];
     uint8_t iterated[ROUND_MAX]; /* no Hessian: the record waits for the Newton rounds */
     for (unsigned b = 0; b < nb; b++) {
         const leaf_voxels *v = &lv[b];
@@ -421,7 +438,7 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
             iterated[n] = !Hb;
             live[n] = 0;
             if (Hb) {
-                rec[n] = model_record(wk, centre[n], v->cf8 + 4 * i, box[n], h, Hb);
+                model_record(wk, centre[n], v->cf8 + 4 * i, box[n], Hb, &ri[n]);
                 n++;
                 continue;
             }
@@ -434,9 +451,12 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
         newton_rounds(wk, &wk->rec[0], w, box, live, n, h);
     for (unsigned j = 0; j < n; j++)
         if (iterated[j])
-            rec[j] = newton_record(wk, &nw[j], centre[j], h);
+            newton_record(wk, &nw[j], centre[j], &ri[j]);
     if (wk->failed || !n)
         return;
+    uint32_t rec[ROUND_MAX]; /* one surface: no surface indices, the records in one push */
+    for (unsigned j = 0; j < n; j++)
+        rec[j] = record_pack(&ri[j], h);
     if (buf_push(&wk->out->voxels, rec, n * sizeof *rec)) {
         wk->failed = 1;
         return;
