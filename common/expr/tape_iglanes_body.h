@@ -87,12 +87,12 @@ static void FN(const tape *t, unsigned n, const tape_ilanes box[3], unsigned fl[
         LANES g[l] = 1;
         switch ((tape_op)in[i].op) {
         case TAPE_CONST: {
-            double lo = k[in[i].a].lo, hi = k[in[i].a].hi;
+            const double lo = k[in[i].a].lo, hi = k[in[i].a].hi, zero = opaque_zero();
             LANES {
                 r->v.lo[l] = lo;
                 r->v.hi[l] = hi;
                 for (int j = 0; j < 3; j++)
-                    r->d[j].lo[l] = r->d[j].hi[l] = 0.0;
+                    r->d[j].lo[l] = r->d[j].hi[l] = zero;
             }
             continue;
         }

@@ -20,6 +20,19 @@ static inline double point_max(double a, double b) { return (a > b || a != a) ? 
  * reduction for both). */
 static inline void point_sincos(double x, double *s, double *c) { sincos_point(x, s, c); }
 
+/* 0.0, which the compiler cannot see is 0.0: a lane loop storing it becomes
+ * vector stores, where one storing the constant became a memset (rep stos,
+ * slow to start, and its stores are not forwarded to the vector loads of the
+ * next ops: docs/perf-log.md). */
+static inline double opaque_zero(void)
+{
+    double z = 0.0;
+#if defined(__GNUC__) && defined(__SSE2__)
+    __asm__("" : "+x"(z));
+#endif
+    return z;
+}
+
 /* The sin and cos of the last TRIG_MEMO argument slots of a trigonometric
  * instruction in one evaluation (slots are written once), so that the sin
  * and cos of one argument (gyroid's sin(3 pi x) and cos(3 pi x)) share one

@@ -33,24 +33,26 @@ static void FN(const tape *t, unsigned n, const double x[L], const double y[L], 
         pt[2][l] = z[l < n ? l : 0];
     }
 /* A variable: its coordinate, and the unit vector along its axis (AX, a
- * constant in each case, so the stores are of constants). */
+ * constant in each case, so the stores are of constants; the zeros
+ * opaque_zero's). */
 #define AXIS(AX)                                                                                   \
     LANES {                                                                                        \
         r->v[l] = pt[AX][l];                                                                       \
-        r->d[0][l] = (AX) == 0 ? 1.0 : 0.0;                                                        \
-        r->d[1][l] = (AX) == 1 ? 1.0 : 0.0;                                                        \
-        r->d[2][l] = (AX) == 2 ? 1.0 : 0.0;                                                        \
+        r->d[0][l] = (AX) == 0 ? 1.0 : zero;                                                       \
+        r->d[1][l] = (AX) == 1 ? 1.0 : zero;                                                       \
+        r->d[2][l] = (AX) == 2 ? 1.0 : zero;                                                       \
     }
+    const double zero = opaque_zero();
     for (uint32_t i = 0, len = t->n; i < len; i++) {
         tape_dual_lanes *restrict r = &s[i];
         uint32_t op = in[i].op;
         double m[L];
         switch ((tape_op)op) {
         case TAPE_CONST: {
-            double v = k[in[i].a].v;
+            const double v = k[in[i].a].v;
             LANES {
                 r->v[l] = v;
-                r->d[0][l] = r->d[1][l] = r->d[2][l] = 0.0;
+                r->d[0][l] = r->d[1][l] = r->d[2][l] = zero;
             }
             break;
         }
