@@ -273,14 +273,16 @@ static void model_record(worker *wk, const double c[3], const double fg[4],
         memcpy(p, c, sizeof p); /* no step: the model at c itself */
         d[0] = d[1] = d[2] = 0.0;
     }
-    double Hd[3], f = f0, g[3]; /* the model at p */
-    for (int r = 0; r < 3; r++) {
-        Hd[r] = H[r][0] * d[0] + H[r][1] * d[1] + H[r][2] * d[2];
-        f += g0[r] * d[r];
-    }
-    f += 0.5 * (d[0] * Hd[0] + d[1] * Hd[1] + d[2] * Hd[2]);
-    for (int r = 0; r < 3; r++)
-        g[r] = g0[r] + Hd[r];
+    /* the model at p, H d in registers (an array of it, stored a term at a
+     * time, was read back as one vector load: docs/perf-log.md) */
+    const double Hd0 = H[0][0] * d[0] + H[0][1] * d[1] + H[0][2] * d[2];
+    const double Hd1 = H[1][0] * d[0] + H[1][1] * d[1] + H[1][2] * d[2];
+    const double Hd2 = H[2][0] * d[0] + H[2][1] * d[1] + H[2][2] * d[2];
+    double f = f0 + g0[0] * d[0];
+    f += g0[1] * d[1];
+    f += g0[2] * d[2];
+    f += 0.5 * (d[0] * Hd0 + d[1] * Hd1 + d[2] * Hd2);
+    const double g[3] = {g0[0] + Hd0, g0[1] + Hd1, g0[2] + Hd2};
     record_in_at(wk, p, f, g, fg, c, ri);
 }
 
