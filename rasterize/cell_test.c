@@ -400,17 +400,22 @@ static int form_decide(interval fc, double plo[3][2], double phi[3][2], double m
     if (!(mag < INFINITY)) /* also NaN */
         return 0;
     const double margin = 0x1p-44 * mag + 0x1p-1000;
-    uint8_t m = 0;
+    /* the comparisons combined without branches: which way each child goes
+     * is data, and mispredicted branches on it were most of this loop's
+     * time (docs/perf-log.md) */
+    unsigned m = 0, undecided = 0;
     for (unsigned i = 0; i < 8; i++) {
         const unsigned bx = i & 1, by = (i >> 1) & 1, bz = i >> 2;
         double lo = fc.lo + plo[0][bx] + plo[1][by] + plo[2][bz];
         double hi = fc.hi + phi[0][bx] + phi[1][by] + phi[2][bz];
-        if (lo > margin || hi < -margin)
-            m |= (uint8_t)(1u << i);
-        else if (!(lo <= -margin && hi >= margin))
-            return 0;
+        const unsigned drop = (unsigned)(lo > margin) | (unsigned)(hi < -margin);
+        const unsigned keep = (unsigned)(lo <= -margin) & (unsigned)(hi >= margin);
+        m |= drop << i;
+        undecided |= ~(drop | keep) & 1u;
     }
-    *fx = m;
+    if (undecided)
+        return 0;
+    *fx = (uint8_t)m;
     return 1;
 }
 
