@@ -241,6 +241,15 @@ fresh(const tape *t, exact_scratch *w, const exact_line *l, double a, double b, 
     return st;
 }
 
+int exact_fast_first(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                     double curv, const exact_bound *cb, double m, exact_model *model, int *have,
+                     double *root, double grad[3])
+{
+    if (!(curv < INFINITY))
+        return EXACT_FAST_UNDECIDED;
+    return fresh(t, w, l, a, b, curv, cb, m, 0, model, have, root, grad);
+}
+
 int exact_fast_root(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                     double curv, const exact_bound *cb, double m_new, exact_model *model,
                     int *have, double *root, double grad[3])

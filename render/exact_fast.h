@@ -70,6 +70,14 @@ int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, doubl
 int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                       double curv, const exact_model *model, double *root, double grad[3]);
 
+/* exact_fast_root's first try alone: a new model at m (*model, *have),
+ * from cb's bound and, where that does not decide, from the per-point one,
+ * asked about [a, b]; no other point is tried. EXACT_FAST_UNDECIDED when
+ * curv is +inf. */
+int exact_fast_first(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
+                     double curv, const exact_bound *cb, double m, exact_model *model, int *have,
+                     double *root, double grad[3]);
+
 /* exact_fast_decide with the caller's model (*have: it holds one, for this
  * line and a box as above) if that decides; else, unless the model's m is
  * within a quarter span of the span's midpoint already, with a new model

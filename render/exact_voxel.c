@@ -173,22 +173,60 @@ static int past_answer(exact_worker *w, int st, double end)
     return EXACT_FAST_ROOT;
 }
 
+/* The span to BEYOND_NEAR voxels past b (within [a, e]), asked where the
+ * span to e is undecided. */
+static int root_near(exact_worker *w, const trace_ray *r, const tape *t_exact, double a, double b,
+                     double e, double curv, double *t, double grad[3])
+{
+    const double near = near_end(r, b);
+    if (!(near < e))
+        return EXACT_FAST_NONE;
+    return past_answer(
+        w, exact_fast_decide(t_exact, &w->scratch, &w->line, a, near, curv, &w->model[0], t, grad),
+        near);
+}
+
 static int root_beyond(exact_worker *w, const trace_ray *r, const uint32_t c[3], unsigned shift,
                        uint64_t key, const tape *t_exact, double a, double b, double curv,
                        double *t, double grad[3])
 {
-    double e = region_exit(w, r, c, shift, key);
+    const double e = region_exit(w, r, c, shift, key);
     if (!(e > b))
         return EXACT_FAST_NONE;
-    int st = exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad);
-    if (st == EXACT_FAST_UNDECIDED) {
-        const double near = near_end(r, b);
-        if (!(near < e))
-            return EXACT_FAST_NONE;
-        e = near;
-        st = exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad);
-    }
+    const int st =
+        exact_fast_decide(t_exact, &w->scratch, &w->line, a, e, curv, &w->model[0], t, grad);
+    if (st == EXACT_FAST_UNDECIDED)
+        return root_near(w, r, t_exact, a, b, e, curv, t, grad);
     return past_answer(w, st, e);
+}
+
+/* The test of a voxel [a, b] of the cell's one surface when its first
+ * model is made (at m, inside [a, e], e > b where the line leaves the
+ * region): that model is asked about [a, e] at once, the question
+ * root_beyond asks after the voxel's own, which it mostly answers (the
+ * root, or no root to e). Undecided there, the voxel's span [a, b] is
+ * tested with it (exact_fast_root) and, holding no root, the span past b
+ * to BEYOND_NEAR voxels (root_near). *have as for exact_fast_root. */
+static int cell_first(exact_worker *w, const trace_ray *r, const tape *t_exact, double a,
+                      double b, double e, double curv, const exact_bound *cb, double m, int *have,
+                      double *t, double grad[3])
+{
+    const exact_line *l = &w->line;
+    int st = exact_fast_first(t_exact, &w->scratch, l, a, e, curv, cb, m, &w->model[0], have, t,
+                              grad);
+    if (st == EXACT_FAST_NONE) {
+        w->clear_to = e;
+        return st;
+    }
+    if (st == EXACT_FAST_ROOT) {
+        if (*t > b)
+            w->beyond++;
+        return st;
+    }
+    st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, NAN, &w->model[0], have, t, grad);
+    if (st == EXACT_FAST_NONE && *have)
+        st = root_near(w, r, t_exact, a, b, e, curv, t, grad);
+    return st;
 }
 
 /* Candidate c of a coarse cell where its tape keeps a kink (hmag +inf) and
@@ -338,17 +376,19 @@ int exact_voxel(exact_worker *w, const trace_ray *r, const uint32_t v[3], double
                     key == 0 && t_exact->n >= w->bound_min_n ? cell_bound(w, k, v) : NULL;
                 /* a first model at the stored plane's hit where it spares a
                  * Newton step of a long tape (one with the a-priori bound) */
-                const double m_new =
-                    !have && cb && k1 - k0 == 1
-                        ? plane_hint(es->tree, r, hit->voxel, v, a,
-                                     region_exit(w, r, rc, rshift, key))
-                        : NAN;
-                st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, m_new, &w->model[j],
-                                     &have, &t, grad);
+                const int alone = k1 - k0 == 1;
+                const double e = !have && cb && alone ? region_exit(w, r, rc, rshift, key) : NAN;
+                const double m_new = e == e ? plane_hint(es->tree, r, hit->voxel, v, a, e) : NAN;
+                if (m_new == m_new && e > b) {
+                    st = cell_first(w, r, t_exact, a, b, e, curv, cb, m_new, &have, &t, grad);
+                } else {
+                    st = exact_fast_root(t_exact, &w->scratch, l, a, b, curv, cb, m_new,
+                                         &w->model[j], &have, &t, grad);
+                    if (st == EXACT_FAST_NONE && have && alone)
+                        st = root_beyond(w, r, rc, rshift, key, t_exact, a, b, curv, &t, grad);
+                }
                 w->have = (w->have & ~bit) | (uint32_t)have << j;
                 w->model_key[j] = key;
-                if (st == EXACT_FAST_NONE && have && k1 - k0 == 1)
-                    st = root_beyond(w, r, rc, rshift, key, t_exact, a, b, curv, &t, grad);
             }
         }
         if (st == EXACT_FAST_UNDECIDED && key == 0 && !(hmag[0] < INFINITY) &&
