@@ -162,6 +162,8 @@ int trace_traverse_sse(const oct_tree *tree, const trace_opts *opts, const trace
             const oct_children ch = oct_node_children(groups[d], n);
             Mn = ch.mask;
             Pn = ch.first;
+            if (d + 1 == levels && tree->voxels)
+                __builtin_prefetch(&tree->voxels[Pn]); /* the records a hit reads: mostly a miss */
         } else {
             if (d > split && d < levels) {
                 /* step two, below K: walk the empty cell voxel by voxel */
