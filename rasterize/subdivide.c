@@ -224,7 +224,8 @@ static uint8_t leaf_batch(worker *wk, unsigned depth, leaf_parent *lp, unsigned 
 {
     const build_ctx *c = wk->c;
     const unsigned pidx = depth + 1;
-    memcpy(&wk->grad[pidx * 3], &wk->grad[depth * 3], 3 * sizeof *wk->grad);
+    for (int k = 0; k < 3; k++) /* (as a memcpy, GCC made it a slow-starting rep movs) */
+        wk->grad[pidx * 3 + k] = wk->grad[depth * 3 + k];
     wk->fcen[pidx] = wk->fcen[depth];
     batch_centres(wk, depth, lp, nb);
     batch_retests(wk, pidx, lp, nb);
@@ -274,10 +275,12 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     const build_ctx *c = wk->c;
     const unsigned ns = c->nsurf, pidx = depth + 1;
     interval pbox[3];
-    double pc[3];
+    /* the centre made in place (a local copy, stored a coordinate at a time
+     * and copied as a vector, made the copy wait for the stores to retire:
+     * docs/perf-log.md); deeper calls write other depths' entries */
+    double *pc = wk->ncen[pidx];
     uint8_t ok[OCT_MAX_SURFACES], fx[OCT_MAX_SURFACES]; /* fx: children the form drops */
     cell_box(c, depth, cell, pbox, pc);
-    memcpy(wk->ncen[pidx], pc, sizeof pc);
     /* The first mean-value node of its task's subtree: the records below
      * it evaluate the tapes made for its box. */
     if ((depth == c->task_depth || depth + MEAN_VALUE_LEVELS == c->levels) &&
