@@ -25,7 +25,8 @@ typedef struct buf {
     size_t n, cap; /* in bytes */
 } buf;
 
-static inline int buf_push(buf *b, const void *data, size_t n)
+/* Room for n more bytes: 0, or -1 when out of memory. */
+static inline int buf_reserve(buf *b, size_t n)
 {
     if (b->n + n > b->cap) {
         size_t cap = b->cap ? b->cap * 2 : 256;
@@ -37,7 +38,26 @@ static inline int buf_push(buf *b, const void *data, size_t n)
         b->p = p;
         b->cap = cap;
     }
+    return 0;
+}
+
+static inline int buf_push(buf *b, const void *data, size_t n)
+{
+    if (buf_reserve(b, n))
+        return -1;
     memcpy(b->p + b->n, data, n);
+    b->n += n;
+    return 0;
+}
+
+/* buf_push of n <= 32 bytes of data, which holds 32: all 32 are copied (a
+ * fixed-size copy is two vector moves, where GCC made the variable one a
+ * rep movsb, slow to start), the length grows by n. */
+static inline int buf_push_small(buf *b, const void *data, size_t n)
+{
+    if (buf_reserve(b, 32))
+        return -1;
+    memcpy(b->p + b->n, data, 32);
     b->n += n;
     return 0;
 }

@@ -206,7 +206,7 @@ static uint8_t kept_voxels(worker *wk, const leaf_parent *p)
     if (!wk->c->par->shell_only)
         return keep;
     unsigned n = bits8(keep);
-    if (n && buf_push(&wk->out->voxels, empty, n * sizeof *empty)) {
+    if (n && buf_push_small(&wk->out->voxels, empty, n * sizeof *empty)) {
         wk->failed = 1;
         return 0;
     }
