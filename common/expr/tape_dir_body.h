@@ -1,9 +1,10 @@
 /* tape_dir_body.h: forward-mode AD in double with N tangents, the rules of
  * tape_eval_grad (abs, min, max: the branch taken), included by
  * tape_eval_dir.c once per N with FN its name, SLOT its slot type (v,
- * d[N]) and LEAF(slot, v, d) the store of a leaf's whole slot. seed[k] is the tangent of coordinate k; every tangent follows the
- * same operations, so one tangent seeded with a direction is, bit for bit,
- * the same whatever the others are. */
+ * d[N]) and LEAF(slot, v, d) the store of a leaf's whole slot. seed[k] is
+ * the tangent of coordinate k; every tangent follows the same operations,
+ * so one tangent seeded with a direction is, bit for bit, the same whatever
+ * the others are. */
 #define OP TAPE_OPL
 #define TANGENTS for (unsigned j = 0; j < N; j++)
 
