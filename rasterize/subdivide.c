@@ -201,6 +201,7 @@ static unsigned bits8(uint8_t m)
 static uint8_t kept_voxels(worker *wk, const leaf_parent *p)
 {
     static const uint32_t empty[8];
+    _Static_assert(sizeof empty == 32, "buf_push_small reads 32 bytes");
     uint8_t keep = (uint8_t)(p->cand & ~(p->centred[0] | p->plain[0]));
     wk->st.taylor_drops += bits8(p->fx[0]) + bits8(p->centred[0]);
     if (!wk->c->par->shell_only)
