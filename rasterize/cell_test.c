@@ -137,11 +137,12 @@ void centred_form_drops(worker *wk, const tape *t, const interval G[3], const re
     unsigned fl[TAPE_LANES], lane[TAPE_LANES], m = 0;
     for (unsigned j = 0; j < n; j++) {
         drop[j] = 0;
-        if (centred_form_may_exclude(G, it[j].box, it[j].centre, it[j].fd)) {
-            for (int k = 0; k < 3; k++)
-                pts[m][k].lo = pts[m][k].hi = it[j].centre[k];
-            lane[m++] = j;
-        }
+        /* the lane written always, kept when the form may exclude 0 (that
+         * outcome, as a branch, was often mispredicted) */
+        for (int k = 0; k < 3; k++)
+            pts[m][k].lo = pts[m][k].hi = it[j].centre[k];
+        lane[m] = j;
+        m += (unsigned)centred_form_may_exclude(G, it[j].box, it[j].centre, it[j].fd);
         if (m == TAPE_LANES || (m && j + 1 == n)) { /* a full pass, or the last */
             lanes_or_one(wk, t, m, pts, out, fl);
             wk->st.interval_evals += m;

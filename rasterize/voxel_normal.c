@@ -431,9 +431,8 @@ void batch_records(worker *wk, const leaf_voxels *lv, unsigned nb)
         if (!v->keep)
             continue;
         const double (*Hb)[3] = have_h[b] ? (const double (*)[3])H[b] : NULL;
-        for (unsigned i = 0; i < 8; i++) {
-            if (!((v->keep >> i) & 1))
-                continue;
+        for (unsigned mk = v->keep; mk; mk &= mk - 1) {
+            const unsigned i = (unsigned)__builtin_ctz(mk);
             w[n] = &nw[n];
             box[n] = v->cb->box[i];
             centre[n] = v->cb->centre[i];

@@ -118,6 +118,25 @@ void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *
     }
 }
 
+/* One pass of batch_centres: f and grad f at n centres, each stored in
+ * its leaf-parent's cf8 (owner, child ch). */
+static void centre_pass(worker *wk, const tape *ct, leaf_parent *lp, unsigned n,
+                        const double *x, const double *y, const double *z,
+                        const unsigned *owner, const unsigned *ch)
+{
+    double f[TAPE_LANES], g[3][TAPE_LANES];
+    centre_values(wk, ct, n, x, y, z, f, g);
+    for (unsigned l = 0; l < n; l++) {
+        leaf_parent *q = &lp[owner[l]];
+        double *fg = q->cf8 + 4 * ch[l];
+        fg[0] = f[l];
+        fg[1] = g[0][l];
+        fg[2] = g[1][l];
+        fg[3] = g[2][l];
+        q->cf8_have |= (uint8_t)(1u << ch[l]);
+    }
+}
+
 /* (see voxel_retest.h) */
 void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
 {
@@ -125,7 +144,7 @@ void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
     const unsigned pidx = depth + 1;
     const tape *t = &wk->tapes[pidx], *ct = centre_tape(wk, t, 0);
     interval *G = &wk->grad[pidx * 3];
-    double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES], f[TAPE_LANES], g[3][TAPE_LANES];
+    double x[TAPE_LANES], y[TAPE_LANES], z[TAPE_LANES];
     unsigned n = 0, owner[TAPE_LANES], ch[TAPE_LANES];
     for (unsigned b = 0; b < nb; b++) {
         leaf_parent *p = &lp[b];
@@ -134,33 +153,29 @@ void batch_centres(worker *wk, unsigned depth, leaf_parent *lp, unsigned nb)
                                              &wk->fcen[pidx], G, 1, &p->fx[0]);
         child_boxes_init(c, depth, p->cell, p->pbox, &p->cb);
         p->cand = p->nofd = p->cf8_have = p->centred[0] = p->plain[0] = 0;
-        for (unsigned i = 0; i < 8 && p->ok[0]; i++)
-            if (!((p->fx[0] >> i) & 1) && child_box(&p->cb, i))
-                p->cand |= (uint8_t)(1u << i);
+        /* (the loops below run over set bits: a test of each of the eight
+         * bits was a branch the predictor missed often) */
+        for (unsigned m = p->ok[0] ? (uint8_t)~p->fx[0] : 0u; m; m &= m - 1) {
+            const unsigned i = (unsigned)__builtin_ctz(m);
+            p->cand |= (uint8_t)((unsigned)child_box(&p->cb, i) << i);
+        }
         p->nofd = skip_centres(wk, wk->fcen[depth], G, wk->ncen[depth], &p->cb, p->cand, p->cf8);
-        for (unsigned i = 0; i < 8; i++) { /* f and grad f at the candidates' centres */
-            if (((p->cand & ~p->nofd) >> i) & 1) {
-                x[n] = p->cb.centre[i][0];
-                y[n] = p->cb.centre[i][1];
-                z[n] = p->cb.centre[i][2];
-                owner[n] = b;
-                ch[n++] = i;
-            }
-            if (n == TAPE_LANES || (n && b + 1 == nb && i == 7)) {
-                centre_values(wk, ct, n, x, y, z, f, g);
-                for (unsigned l = 0; l < n; l++) {
-                    leaf_parent *q = &lp[owner[l]];
-                    double *fg = q->cf8 + 4 * ch[l];
-                    fg[0] = f[l];
-                    fg[1] = g[0][l];
-                    fg[2] = g[1][l];
-                    fg[3] = g[2][l];
-                    q->cf8_have |= (uint8_t)(1u << ch[l]);
-                }
+        /* f and grad f at the candidates' centres, in passes of TAPE_LANES */
+        for (unsigned m = p->cand & (uint8_t)~p->nofd; m; m &= m - 1) {
+            const unsigned i = (unsigned)__builtin_ctz(m);
+            x[n] = p->cb.centre[i][0];
+            y[n] = p->cb.centre[i][1];
+            z[n] = p->cb.centre[i][2];
+            owner[n] = b;
+            ch[n++] = i;
+            if (n == TAPE_LANES) {
+                centre_pass(wk, ct, lp, n, x, y, z, owner, ch);
                 n = 0;
             }
         }
     }
+    if (n)
+        centre_pass(wk, ct, lp, n, x, y, z, owner, ch);
 }
 
 /* (see voxel_retest.h) */
@@ -175,18 +190,17 @@ void batch_retests(worker *wk, unsigned pidx, leaf_parent *lp, unsigned nb)
     retest_item fit[64];
     uint8_t fdrop[64];
     for (unsigned b = 0; b < nb; b++)
-        for (unsigned i = 0; i < 8; i++)
-            if ((lp[b].cand >> i) & 1) {
-                retest_item r = {lp[b].cb.box[i], lp[b].cb.centre[i], lp[b].cf8[4 * i]};
-                it_lp[nit] = (uint8_t)b;
-                it_ch[nit] = (uint8_t)i;
-                drop[nit] = 0;
-                if (!((lp[b].nofd >> i) & 1)) {
-                    fdj[nfd] = nit;
-                    fit[nfd++] = r;
-                }
-                it[nit++] = r;
-            }
+        for (unsigned mk = lp[b].cand; mk; mk &= mk - 1) {
+            const unsigned i = (unsigned)__builtin_ctz(mk);
+            retest_item r = {lp[b].cb.box[i], lp[b].cb.centre[i], lp[b].cf8[4 * i]};
+            it_lp[nit] = (uint8_t)b;
+            it_ch[nit] = (uint8_t)i;
+            drop[nit] = 0;
+            fdj[nfd] = nit; /* (kept when the form is to run: no branch) */
+            fit[nfd] = r;
+            nfd += !((lp[b].nofd >> i) & 1);
+            it[nit++] = r;
+        }
     if (nfd) { /* (the guard also shows GCC that fit is written before it is read) */
         centred_form_drops(wk, t, G, fit, nfd, fdrop);
         for (unsigned j = 0; j < nfd; j++)
