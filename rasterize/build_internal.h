@@ -151,6 +151,8 @@ typedef struct worker {
     tape_dual_lanes *lslots;
     tape_ilanes *ilslots;  /* the lane interval evaluator's scratch */
     tape_idual_lanes *iglslots; /* the lane interval gradient evaluator's */
+    tape_ilanes *coarse_slots; /* [(levels + 2) * max_len], children_may_cross's, or NULL
+                                  (a long tape: cell_test_surviving alone) */
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
     tape *rec;             /* [nsurf]: the tapes the records evaluate (record_tapes) */
@@ -191,6 +193,30 @@ typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
  * box. Returns how many surfaces may cross it. */
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
                              interval box[3], double centre[3]);
+
+/* The longest tape whose children_may_cross lanes a worker keeps: 128
+ * bytes an instruction at each depth. */
+#define COARSE_LANES_MAX_LEN 1024
+
+/* The children of a node above the mean-value levels, tested together
+ * (children_may_cross) and taken one at a time (child_take). */
+typedef struct coarse_children {
+    uint64_t cell[8][3];   /* set by the caller */
+    interval box[8][3];
+    double centre[8][3];
+    unsigned flags[8];
+    uint8_t lane[8], slot_lane[8]; /* a lane's child, a child's lane */
+} coarse_children;
+
+/* With one surface and the interval method: the plain test of the children
+ * of the node (depth) named by want (cc->cell set for them), together in
+ * the lane evaluator; their slot enclosures stay in the worker for
+ * child_take. Returns the children that may be crossed, the same bits and
+ * counts as cell_test_surviving on each. Needs wk->coarse_slots. */
+uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_children *cc);
+/* What cell_test_surviving leaves for child i of cc that may be crossed:
+ * its lists and pruned tape at index depth + 2. */
+void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned i);
 
 /* The tapes the records of the voxels under the node (lists at index idx,
  * box) evaluate, into wk->rec: each surface's full tape with the min, max

@@ -228,6 +228,24 @@ static int lipschitz_excludes_zero(worker *wk, const tape *t, const interval box
     return fc.lo > bound || fc.hi < -bound;
 }
 
+/* surface_may_cross's decision from the enclosure v of f over the cell and
+ * its flags (BUILD_INTERVAL), with its counts. */
+static int may_cross_from(worker *wk, const tape *t, unsigned s, interval v, unsigned flags)
+{
+    wk->st.interval_evals++;
+    wk->st.insns_evaluated += t->n;
+    wk->st.insns_full += wk->c->full[s]->n;
+    if (interval_is_nan(v)) { /* defined nowhere in the cell: no surface point */
+        wk->st.nan_cells++;
+        return 0;
+    }
+    if (flags) {
+        wk->st.nan_cells++;
+        return v.lo <= 0.0 && v.hi >= 0.0;
+    }
+    return !(v.lo > 0.0 || v.hi < 0.0);
+}
+
 /* The plain test of one surface on one cell: 0 when the cell provably holds
  * no point of it. Leaves the slot enclosures in wk->slots for pruning and
  * sets *flags. */
@@ -237,20 +255,9 @@ static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned dep
     const build_ctx *c = wk->c;
     *flags = 0;
     interval v = tape_eval_interval(t, box, wk->slots, flags);
-    wk->st.interval_evals++;
-    wk->st.insns_evaluated += t->n;
-    wk->st.insns_full += c->full[s]->n;
-    if (interval_is_nan(v)) { /* defined nowhere in the cell: no surface point */
-        wk->st.nan_cells++;
+    if (!may_cross_from(wk, t, s, v, *flags))
         return 0;
-    }
-    if (*flags) {
-        wk->st.nan_cells++;
-        return v.lo <= 0.0 && v.hi >= 0.0;
-    }
-    if (v.lo > 0.0 || v.hi < 0.0)
-        return 0;
-    if (c->par->method == BUILD_LIPSCHITZ && lipschitz_excludes_zero(wk, t, box, centre)) {
+    if (c->par->method == BUILD_LIPSCHITZ && !*flags && lipschitz_excludes_zero(wk, t, box, centre)) {
         if (depth == c->levels)
             wk->st.taylor_drops++;
         return 0;
@@ -261,7 +268,6 @@ static int surface_may_cross(worker *wk, const tape *t, unsigned s, unsigned dep
 void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,
                       uint8_t *drop)
 {
-    const build_ctx *c = wk->c;
     interval boxes[TAPE_LANES][3], out[TAPE_LANES];
     unsigned fl[TAPE_LANES];
     for (unsigned j0 = 0; j0 < n; j0 += TAPE_LANES) {
@@ -269,23 +275,36 @@ void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *
         for (unsigned l = 0; l < m; l++)
             memcpy(boxes[l], it[j0 + l].box, sizeof boxes[l]);
         lanes_or_one(wk, t, m, boxes, out, fl);
-        for (unsigned l = 0; l < m; l++) { /* surface_may_cross's rules, BUILD_INTERVAL */
-            interval v = out[l];
-            wk->st.interval_evals++;
-            wk->st.insns_evaluated += t->n;
-            wk->st.insns_full += c->full[s]->n;
-            int keep;
-            if (interval_is_nan(v)) {
-                wk->st.nan_cells++;
-                keep = 0;
-            } else if (fl[l]) {
-                wk->st.nan_cells++;
-                keep = v.lo <= 0.0 && v.hi >= 0.0;
-            } else {
-                keep = !(v.lo > 0.0 || v.hi < 0.0);
-            }
-            drop[j0 + l] = (uint8_t)!keep;
-        }
+        for (unsigned l = 0; l < m; l++) /* surface_may_cross's rules, BUILD_INTERVAL */
+            drop[j0 + l] = (uint8_t)!may_cross_from(wk, t, s, out[l], fl[l]);
+    }
+}
+
+/* The tape of surface s for the cell (depth) that may cross it, from its
+ * parent's (lists at index pidx) and its slot enclosures in wk->slots with
+ * their flags, into the cell's lists (index depth + 1). */
+static void cell_tape(worker *wk, unsigned pidx, unsigned depth, unsigned s, unsigned flags)
+{
+    const build_ctx *c = wk->c;
+    const unsigned idx = depth + 1, ns = c->nsurf;
+    const tape *t = &wk->tapes[(size_t)pidx * ns + s];
+    tape *child = &wk->tapes[(size_t)idx * ns + s];
+    if (depth < c->levels) {
+        /* Inherited by the whole subtree: decided min/max keep their
+         * winner, and terms that no longer vary over the cell (a far
+         * blob's exp(-50)) become constants. "No longer vary": narrower
+         * than a thousandth of f's spread over one voxel, estimated from
+         * its enclosure over this cell. */
+        interval v = wk->slots[t->root];
+        double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(c->levels - depth));
+        tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
+        tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
+        tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
+                         wk->scratch, child);
+        wk->kinked[(size_t)idx * ns + s] = tape_has_kink(child);
+    } else {
+        *child = *t;
+        wk->kinked[(size_t)idx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
     }
 }
 
@@ -303,27 +322,52 @@ unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const ui
         if (!surface_may_cross(wk, t, s, depth, box, centre, &flags))
             continue;
         wk->act[(size_t)idx * ns + n++] = (uint8_t)s;
-        tape *child = &wk->tapes[(size_t)idx * ns + s];
-        if (depth < c->levels) {
-            /* Inherited by the whole subtree: decided min/max keep their
-             * winner, and terms that no longer vary over the cell (a far
-             * blob's exp(-50)) become constants. "No longer vary": narrower
-             * than a thousandth of f's spread over one voxel, estimated from
-             * its enclosure over this cell. */
-            interval v = wk->slots[t->root];
-            double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(c->levels - depth));
-            tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
-            tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
-            tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
-                             wk->scratch, child);
-            wk->kinked[(size_t)idx * ns + s] = tape_has_kink(child);
-        } else {
-            *child = *t;
-            wk->kinked[(size_t)idx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
-        }
+        cell_tape(wk, pidx, depth, s, flags);
     }
     wk->nact[idx] = n;
     return n;
+}
+
+/* (see build_internal.h) */
+uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_children *cc)
+{
+    const build_ctx *c = wk->c;
+    const tape *t = &wk->tapes[depth + 1];
+    interval box[8][3], out[8];
+    unsigned fl[8], n = 0;
+    for (unsigned m = want; m; m &= m - 1) {
+        const unsigned i = (unsigned)__builtin_ctz(m);
+        cc->lane[n] = (uint8_t)i;
+        n += (unsigned)cell_box(c, depth + 1, cc->cell[i], box[n], cc->centre[i]);
+    }
+    if (!n)
+        return 0;
+    tape_ilanes *sl = wk->coarse_slots + (size_t)depth * c->max_len;
+    tape_eval_interval_lanes(t, n, (const interval(*)[3])box, out, fl, sl);
+    uint8_t live = 0;
+    for (unsigned l = 0; l < n; l++) {
+        const unsigned i = cc->lane[l];
+        memcpy(cc->box[i], box[l], sizeof box[l]);
+        cc->flags[i] = fl[l];
+        cc->slot_lane[i] = (uint8_t)l;
+        live |= (uint8_t)(may_cross_from(wk, t, 0, out[l], fl[l]) << i);
+    }
+    return live;
+}
+
+/* (see build_internal.h) */
+void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned i)
+{
+    const tape *t = &wk->tapes[depth + 1];
+    const tape_ilanes *sl = wk->coarse_slots + (size_t)depth * wk->c->max_len;
+    const unsigned l = cc->slot_lane[i];
+    for (uint32_t j = 0; j < t->n; j++) {
+        wk->slots[j].lo = sl[j].lo[l];
+        wk->slots[j].hi = sl[j].hi[l];
+    }
+    wk->act[depth + 2] = 0;
+    wk->nact[depth + 2] = 1;
+    cell_tape(wk, depth + 1, depth + 1, 0, cc->flags[i]);
 }
 
 void record_tapes(worker *wk, unsigned idx, const interval box[3])

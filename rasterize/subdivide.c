@@ -1,9 +1,10 @@
 /* subdivide: the recursion. A task's cell is subdivided depth-first,
  * children in slot order, so every depth's nodes come out in Morton order.
- * Above the finest MEAN_VALUE_LEVELS a child is tested on its own with its
- * parent's pruned tapes (cell_test_surviving); there and below, all eight at once with
- * the mean-value form (child_enclosures); a leaf-parent's voxels then take
- * the re-tests of voxel_retest.c. */
+ * Above the finest MEAN_VALUE_LEVELS a child is tested with its parent's
+ * pruned tapes by the plain interval test (cell_test_surviving; with one
+ * surface the eight together, children_may_cross); there and below, all
+ * eight at once with the mean-value form (child_enclosures); a
+ * leaf-parent's voxels then take the re-tests of voxel_retest.c. */
 #include "rasterize/build_internal.h"
 #include "rasterize/cell_geometry.h"
 #include "rasterize/voxel_retest.h"
@@ -330,6 +331,28 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     return visit_children(wk, depth, cell, ok, fx, &cb, retest, centred, plain, NULL, NULL);
 }
 
+/* The children of a node above the mean-value levels, of a single-surface
+ * scene: their plain tests together (children_may_cross), then each that
+ * may be crossed visited in slot order with its pruned tape. */
+static uint8_t visit_coarse(worker *wk, unsigned depth, const uint64_t cell[3])
+{
+    coarse_children cc;
+    uint8_t want = 0, mask = 0;
+    for (unsigned i = 0; i < 8; i++) {
+        cc.cell[i][0] = 2 * cell[0] + (i & 1);
+        cc.cell[i][1] = 2 * cell[1] + ((i >> 1) & 1);
+        cc.cell[i][2] = 2 * cell[2] + (i >> 2);
+        want |= (uint8_t)(shard_meets(wk->c, depth + 1, cc.cell[i]) << i); /* this shard's piece */
+    }
+    for (unsigned m = children_may_cross(wk, depth, want, &cc); m && !wk->failed; m &= m - 1) {
+        const unsigned i = (unsigned)__builtin_ctz(m);
+        child_take(wk, depth, &cc, i);
+        if (visit_node(wk, depth + 1, cc.cell[i], NULL))
+            mask |= (uint8_t)(1u << i);
+    }
+    return mask;
+}
+
 /* Builds the subtree of a cell already tested non-empty; returns its child
  * mask (0 when nothing below it survived). */
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
@@ -339,6 +362,9 @@ static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
     uint8_t mask = 0;
     if (depth + MEAN_VALUE_LEVELS >= c->levels && c->par->method == BUILD_INTERVAL) {
         mask = visit_mean_value(wk, depth, cell, given);
+    } else if (c->nsurf == 1 && c->par->method == BUILD_INTERVAL && depth + 1 < c->levels &&
+               wk->coarse_slots) {
+        mask = visit_coarse(wk, depth, cell);
     } else {
         for (unsigned i = 0; i < 8 && !wk->failed; i++) {
             uint64_t cc[3] = {2 * cell[0] + (i & 1), 2 * cell[1] + ((i >> 1) & 1),

@@ -74,6 +74,14 @@ static void check(int path, const tape *t, const interval box[][3], unsigned n, 
                      what, tape_lanes_path_name(path), l, n, box[l][0].lo, box[l][0].hi,
                      box[l][1].lo, box[l][1].hi, box[l][2].lo, box[l][2].hi, out[l].lo,
                      out[l].hi, fl[l], r.lo, r.hi, f1);
+        /* every slot too: the rasterizer prunes a cell's tape from them
+         * (children_may_cross) */
+        for (uint32_t i = 0; i < t->n; i++)
+            if (!same_bits(lslots[i].lo[l], islots[i].lo) ||
+                !same_bits(lslots[i].hi[l], islots[i].hi))
+                fail_msg("%s path %s lane %u of %u: slot %u [%a,%a], scalar [%a,%a]", what,
+                         tape_lanes_path_name(path), l, n, (unsigned)i, lslots[i].lo[l],
+                         lslots[i].hi[l], islots[i].lo, islots[i].hi);
     }
     check_grad(path, t, box, n, what);
 }

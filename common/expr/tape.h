@@ -144,9 +144,10 @@ interval tape_eval_interval(const tape *t, const interval box[3], interval *slot
 
 /* tape_eval_interval on up to TAPE_LANES boxes at once: out[l] and flags[l]
  * are, bit for bit, tape_eval_interval's result and flags on box[l], for
- * l < n (1 <= n <= TAPE_LANES). The cheap operations run on all lanes in
- * one pass (vector code), the libm ones lane by lane. `slots` is the
- * caller's scratch of t->n elements (common/expr/tape_ilanes.c). */
+ * l < n (1 <= n <= TAPE_LANES), and lane l of slots[i] its slot i (for
+ * tape_prune). The cheap operations run on all lanes in one pass (vector
+ * code), the libm ones lane by lane. `slots` is the caller's scratch of t->n
+ * elements (common/expr/tape_ilanes.c). */
 typedef struct tape_ilanes {
     double lo[TAPE_LANES], hi[TAPE_LANES];
 } tape_ilanes;
