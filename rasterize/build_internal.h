@@ -153,6 +153,8 @@ typedef struct worker {
     tape_idual_lanes *iglslots; /* the lane interval gradient evaluator's */
     tape_ilanes *coarse_slots; /* [(levels + 2) * max_len], children_may_cross's, or NULL
                                   (a long tape: cell_test_surviving alone) */
+    tape_insn *own_insn;   /* [8 * tape_total]: child_prune's tapes, with coarse_slots */
+    tape_const *own_konst; /* [8 * konst_total] */
     uint32_t *scratch;
     tape_insn *prune;      /* [(levels + 2) * tape_total] */
     tape *rec;             /* [nsurf]: the tapes the records evaluate (record_tapes) */
@@ -206,6 +208,8 @@ typedef struct coarse_children {
     double centre[8][3];
     unsigned flags[8];
     uint8_t lane[8], slot_lane[8]; /* a lane's child, a child's lane */
+    tape tape[8];          /* child_prune's */
+    uint8_t kinked[8];
 } coarse_children;
 
 /* With one surface and the interval method: the plain test of the children
@@ -217,6 +221,11 @@ uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_chil
 /* What cell_test_surviving leaves for child i of cc that may be crossed:
  * its lists and pruned tape at index depth + 2. */
 void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned i);
+/* Child i's pruned tape as child_take makes it, into cc->tape[i] (and
+ * cc->kinked[i]), its instructions in the worker's slot i for them: the
+ * children of one node at a time, such as the mean-value levels' first
+ * nodes, whose forms are then made together. */
+void child_prune(worker *wk, unsigned depth, coarse_children *cc, unsigned i);
 
 /* The tapes the records of the voxels under the node (lists at index idx,
  * box) evaluate, into wk->rec: each surface's full tape with the min, max

@@ -280,6 +280,23 @@ void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *
     }
 }
 
+/* t pruned for the cell (depth < levels) from the slot enclosures over it
+ * in wk->slots with their flags, into child (instructions out, constants
+ * konst). Inherited by the whole subtree: decided min/max keep their
+ * winner, and terms that no longer vary over the cell (a far blob's
+ * exp(-50)) become constants. "No longer vary": narrower than a thousandth
+ * of f's spread over one voxel, estimated from its enclosure over this
+ * cell. Returns whether child has a kink. */
+static uint8_t prune_for_cell(worker *wk, const tape *t, unsigned depth, unsigned flags,
+                              tape_insn *out, tape_const *konst, tape *child)
+{
+    interval v = wk->slots[t->root];
+    double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(wk->c->levels - depth));
+    tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst, wk->scratch,
+                     child);
+    return tape_has_kink(child);
+}
+
 /* The tape of surface s for the cell (depth) that may cross it, from its
  * parent's (lists at index pidx) and its slot enclosures in wk->slots with
  * their flags, into the cell's lists (index depth + 1). */
@@ -290,18 +307,9 @@ static void cell_tape(worker *wk, unsigned pidx, unsigned depth, unsigned s, uns
     const tape *t = &wk->tapes[(size_t)pidx * ns + s];
     tape *child = &wk->tapes[(size_t)idx * ns + s];
     if (depth < c->levels) {
-        /* Inherited by the whole subtree: decided min/max keep their
-         * winner, and terms that no longer vary over the cell (a far
-         * blob's exp(-50)) become constants. "No longer vary": narrower
-         * than a thousandth of f's spread over one voxel, estimated from
-         * its enclosure over this cell. */
-        interval v = wk->slots[t->root];
-        double tiny = 1e-3 * ldexp(v.hi - v.lo, -(int)(c->levels - depth));
-        tape_insn *out = wk->prune + (size_t)idx * c->tape_total + c->tape_off[s];
-        tape_const *konst = wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s];
-        tape_prune_const(t, wk->slots, flags, isfinite(tiny) ? tiny : -1.0, out, konst,
-                         wk->scratch, child);
-        wk->kinked[(size_t)idx * ns + s] = tape_has_kink(child);
+        wk->kinked[(size_t)idx * ns + s] =
+            prune_for_cell(wk, t, depth, flags, wk->prune + (size_t)idx * c->tape_total + c->tape_off[s],
+                           wk->prune_konst + (size_t)idx * c->konst_total + c->konst_off[s], child);
     } else {
         *child = *t;
         wk->kinked[(size_t)idx * ns + s] = wk->kinked[(size_t)pidx * ns + s];
@@ -355,8 +363,9 @@ uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_chil
     return live;
 }
 
-/* (see build_internal.h) */
-void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned i)
+/* Child i's slot enclosures, from its lane of children_may_cross, into
+ * wk->slots. */
+static void child_slots(worker *wk, unsigned depth, const coarse_children *cc, unsigned i)
 {
     const tape *t = &wk->tapes[depth + 1];
     const tape_ilanes *sl = wk->coarse_slots + (size_t)depth * wk->c->max_len;
@@ -365,9 +374,25 @@ void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned 
         wk->slots[j].lo = sl[j].lo[l];
         wk->slots[j].hi = sl[j].hi[l];
     }
+}
+
+/* (see build_internal.h) */
+void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned i)
+{
+    child_slots(wk, depth, cc, i);
     wk->act[depth + 2] = 0;
     wk->nact[depth + 2] = 1;
     cell_tape(wk, depth + 1, depth + 1, 0, cc->flags[i]);
+}
+
+/* (see build_internal.h) */
+void child_prune(worker *wk, unsigned depth, coarse_children *cc, unsigned i)
+{
+    const build_ctx *c = wk->c;
+    child_slots(wk, depth, cc, i);
+    cc->kinked[i] = prune_for_cell(wk, &wk->tapes[depth + 1], depth + 1, cc->flags[i],
+                                   wk->own_insn + (size_t)i * c->tape_total,
+                                   wk->own_konst + (size_t)i * c->konst_total, &cc->tape[i]);
 }
 
 void record_tapes(worker *wk, unsigned idx, const interval box[3])

@@ -20,6 +20,23 @@ _Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradie
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
                           const node_form *given);
 
+static unsigned bits8(uint8_t m)
+{
+    unsigned n = 0;
+    for (; m; m &= (uint8_t)(m - 1))
+        n++;
+    return n;
+}
+
+/* Whether tapes a and b evaluate alike: the same instructions, root and
+ * constants. */
+static int same_tape(const tape *a, const tape *b)
+{
+    return a->n == b->n && a->root == b->root && a->nconst == b->nconst &&
+           !memcmp(a->insn, b->insn, a->n * sizeof *a->insn) &&
+           !memcmp(a->konst, b->konst, a->nconst * sizeof *a->konst);
+}
+
 /* Whether a child of the node (depth) takes the plain interval test for
  * surface k after the node's mean-value form (ok: that form was available):
  * without the form, or on coarse cells. */
@@ -191,14 +208,6 @@ static void push_mask(worker *wk, unsigned depth, uint8_t mask)
  * children the form and the re-tests left are its voxels (returned, the
  * drops counted). With --shell-only each goes out as an empty record here;
  * otherwise their records are made by batch_records. */
-static unsigned bits8(uint8_t m)
-{
-    unsigned n = 0;
-    for (; m; m &= (uint8_t)(m - 1))
-        n++;
-    return n;
-}
-
 static uint8_t kept_voxels(worker *wk, const leaf_parent *p)
 {
     static const uint32_t empty[8];
@@ -331,23 +340,72 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     return visit_children(wk, depth, cell, ok, fx, &cb, retest, centred, plain, NULL, NULL);
 }
 
+/* The forms of the node's children that may be crossed (live), the
+ * mean-value levels' first nodes, with their tapes made (child_prune):
+ * those whose tapes are alike (same_tape) together, on one of them
+ * (node_forms: the bits each one's own evaluations would give). */
+static void children_forms(worker *wk, coarse_children *cc, uint8_t live, node_form nf[8])
+{
+    uint8_t left = live;
+    while (left) {
+        const unsigned r = (unsigned)__builtin_ctz(left); /* the group's first */
+        interval box[8][3];
+        double centre[8][3];
+        uint8_t member[8];
+        unsigned n = 0;
+        for (unsigned m = left; m; m &= m - 1) {
+            const unsigned i = (unsigned)__builtin_ctz(m);
+            if (i != r && !same_tape(&cc->tape[i], &cc->tape[r]))
+                continue;
+            memcpy(box[n], cc->box[i], sizeof box[n]);
+            memcpy(centre[n], cc->centre[i], sizeof centre[n]);
+            member[n++] = (uint8_t)i;
+            left &= (uint8_t)~(1u << i);
+        }
+        node_form f[8];
+        node_forms(wk, &cc->tape[r], 0, n, box, (const double(*)[3])centre, f);
+        for (unsigned j = 0; j < n; j++)
+            nf[member[j]] = f[j];
+    }
+}
+
 /* The children of a node above the mean-value levels, of a single-surface
  * scene: their plain tests together (children_may_cross), then each that
  * may be crossed visited in slot order with its pruned tape. */
 static uint8_t visit_coarse(worker *wk, unsigned depth, const uint64_t cell[3])
 {
+    const build_ctx *c = wk->c;
     coarse_children cc;
     uint8_t want = 0, mask = 0;
     for (unsigned i = 0; i < 8; i++) {
         cc.cell[i][0] = 2 * cell[0] + (i & 1);
         cc.cell[i][1] = 2 * cell[1] + ((i >> 1) & 1);
         cc.cell[i][2] = 2 * cell[2] + (i >> 2);
-        want |= (uint8_t)(shard_meets(wk->c, depth + 1, cc.cell[i]) << i); /* this shard's piece */
+        want |= (uint8_t)(shard_meets(c, depth + 1, cc.cell[i]) << i); /* this shard's piece */
     }
-    for (unsigned m = children_may_cross(wk, depth, want, &cc); m && !wk->failed; m &= m - 1) {
+    const uint8_t live = children_may_cross(wk, depth, want, &cc);
+    if (depth + 1 + MEAN_VALUE_LEVELS != c->levels) {
+        for (unsigned m = live; m && !wk->failed; m &= m - 1) {
+            const unsigned i = (unsigned)__builtin_ctz(m);
+            child_take(wk, depth, &cc, i);
+            if (visit_node(wk, depth + 1, cc.cell[i], NULL))
+                mask |= (uint8_t)(1u << i);
+        }
+        return mask;
+    }
+    /* the mean-value levels' first nodes: all their tapes, then their
+     * forms, then each visited */
+    node_form nf[8];
+    for (unsigned m = live; m; m &= m - 1)
+        child_prune(wk, depth, &cc, (unsigned)__builtin_ctz(m));
+    children_forms(wk, &cc, live, nf);
+    for (unsigned m = live; m && !wk->failed; m &= m - 1) {
         const unsigned i = (unsigned)__builtin_ctz(m);
-        child_take(wk, depth, &cc, i);
-        if (visit_node(wk, depth + 1, cc.cell[i], NULL))
+        wk->tapes[depth + 2] = cc.tape[i];
+        wk->kinked[depth + 2] = cc.kinked[i];
+        wk->act[depth + 2] = 0;
+        wk->nact[depth + 2] = 1;
+        if (visit_node(wk, depth + 1, cc.cell[i], &nf[i]))
             mask |= (uint8_t)(1u << i);
     }
     return mask;

@@ -30,8 +30,11 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->lslots = malloc(len * sizeof *wk->lslots);
     wk->ilslots = malloc(len * sizeof *wk->ilslots);
     wk->iglslots = malloc(len * sizeof *wk->iglslots);
-    if (len <= COARSE_LANES_MAX_LEN) /* (a depth's lanes kept while its subtree is built) */
+    if (len <= COARSE_LANES_MAX_LEN) { /* (a depth's lanes kept while its subtree is built) */
         wk->coarse_slots = malloc(depths * len * sizeof *wk->coarse_slots);
+        wk->own_insn = malloc(8 * (c->tape_total ? c->tape_total : 1) * sizeof *wk->own_insn);
+        wk->own_konst = malloc(8 * (c->konst_total ? c->konst_total : 1) * sizeof *wk->own_konst);
+    }
     if (!wk->ilslots || !wk->iglslots || !wk->slots || !wk->slots2 || !wk->islots || !wk->dslots || !wk->lslots || !wk->scratch ||
         !wk->prune || !wk->prune_konst || !wk->rec || !wk->rec_insn || !wk->tapes || !wk->act || !wk->kinked || !wk->nact || !wk->grad ||
         !wk->grad_ok || !wk->fcen || !wk->ncen || !wk->cf || !wk->cf_ok || !wk->cf8 || !wk->cf8_have)
@@ -43,7 +46,7 @@ int worker_init(worker *wk, const build_ctx *c)
         wk->kinked[s] = tape_has_kink(c->full[s]);
     }
     wk->nact[0] = c->nsurf;
-    if (len <= COARSE_LANES_MAX_LEN && !wk->coarse_slots)
+    if (len <= COARSE_LANES_MAX_LEN && (!wk->coarse_slots || !wk->own_insn || !wk->own_konst))
         return -1;
     return 0;
 }
@@ -56,4 +59,5 @@ void worker_free(worker *wk)
     free(wk->grad); free(wk->grad_ok); free(wk->fcen); free(wk->ncen);
     free(wk->cf); free(wk->cf_ok); free(wk->cf8); free(wk->cf8_have); free(wk->lslots);
     free(wk->ilslots); free(wk->iglslots); free(wk->coarse_slots);
+    free(wk->own_insn); free(wk->own_konst);
 }
