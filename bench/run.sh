@@ -18,7 +18,7 @@ quick) # manyblobs' reference alone would take a minute
     SIZE=${SIZE:-512}; NVIEWS=${NVIEWS:-1}; REPS=${REPS:-3}; RAST_REPS=${RAST_REPS:-1}
     FIG_LEVELS=${FIG_LEVELS:-8}; FIG_SIZES=${FIG_SIZES:-"256 512"}; POV_SIZE=${POV_SIZE:-256}
     SPEED_SCENES=${SPEED_SCENES:-"blobs_a csg"}; SPEED_LEVELS=${SPEED_LEVELS:-8}; SPEED_REPS=${SPEED_REPS:-1}
-    SHELL_LEVELS=${SHELL_LEVELS:-7}
+    SHELL_LEVELS=${SHELL_LEVELS:-7}; RATIO_LEVELS=${RATIO_LEVELS:-8}; RATIO_PAIRS=${RATIO_PAIRS:-3}
     ACC_SCENES=${ACC_SCENES:-"sphere torus crease csg cube heart plate thin gyroid_ball"}
     ACC_LEVELS=${ACC_LEVELS:-9}; ACC_SIZE=${ACC_SIZE:-128}
     SWEEP_SCENES=${SWEEP_SCENES:-"blobs_a csg"}; SWEEP_LEVELS=${SWEEP_LEVELS:-"6 7 8 9"}
@@ -31,6 +31,7 @@ full)
     POV_SIZE=${POV_SIZE:-1024}
     SPEED_SCENES=${SPEED_SCENES:-"blobs_a blobs_b csg gyroid manyblobs"}
     SPEED_LEVELS=${SPEED_LEVELS:-"10 12"}; SPEED_REPS=${SPEED_REPS:-3}; SHELL_LEVELS=${SHELL_LEVELS:-9}
+    RATIO_LEVELS=${RATIO_LEVELS:-10}; RATIO_PAIRS=${RATIO_PAIRS:-9}
     ACC_SCENES=${ACC_SCENES:-$(for f in scenes/*.scene; do basename "$f" .scene; done)}
     ACC_LEVELS=${ACC_LEVELS:-"9 10"}; ACC_SIZE=${ACC_SIZE:-256}
     SWEEP_SCENES=${SWEEP_SCENES:-"blobs_a blobs_b thin csg gyroid manyblobs"}
@@ -38,7 +39,7 @@ full)
 *)
     echo "usage: bench/run.sh quick|full" >&2; exit 2 ;;
 esac
-SECTIONS=${SECTIONS:-"main speed accuracy sweep fig4 images pov shard eval"}
+SECTIONS=${SECTIONS:-"main ratio speed accuracy sweep fig4 images pov shard eval"}
 REPORT=${REPORT:-README.md}
 want() { case " $SECTIONS " in *" $1 "*) return 0 ;; esac; return 1; }
 D=$(dirname "$0")
@@ -148,6 +149,39 @@ if want main; then
             render_views "$oct" "$s" "$L" exact
             case $s.$L in blobs_a.$FIG_LEVELS|blobs_b.$FIG_LEVELS) ;; *) rm -f "$oct" ;; esac
         done
+    done
+fi
+
+# ---- issue 14's ratio: --exact against the paper's rule on the standard view,
+# frames of the two alternating in one mapping (the same file, machine state
+# and warmed caches for both), RATIO_PAIRS pairs after one warm-up pair, the
+# median of each ----
+if want ratio; then
+    RAT="$RES/exactratio.csv"
+    echo "$PROVH,scene,levels,size,pairs,plain_ms,exact_ms,ratio" >"$RAT"
+    for s in blobs_a csg; do
+        oct="$WORK/ratio.oct" L=$RATIO_LEVELS
+        "$BIN/rasterize" "scenes/$s.scene" -o "$oct" --levels "$L" -q
+        set -- $(NVIEWS=1 views "scenes/$s.scene")
+        vf="$WORK/ratio.views"; : >"$vf"
+        i=0
+        while [ $i -le "$RATIO_PAIRS" ]; do
+            for m in plain exact; do
+                flag=""; [ $m = exact ] && flag=--exact
+                echo "-o $WORK/ratio.$m.$i.png --size ${SIZE}x$SIZE --eye $2 --target $3 --up $4 --fov 30 $flag" >>"$vf"
+            done
+            i=$((i + 1))
+        done
+        "$BIN/render" "$oct" --views "$vf" 2>"$WORK/vlog"
+        rm -f "$oct" "$WORK"/ratio.*.png
+        for m in plain exact; do # (pair 0, the warm-up, left out)
+            sed -n "s|^render: $WORK/ratio\.$m\.[0-9]*\.png: [0-9x]*, \([0-9.]*\) ms,.*|\1|p" "$WORK/vlog" |
+                tail -n "$RATIO_PAIRS" | median >"$WORK/ratio.$m"
+        done
+        p=$(cat "$WORK/ratio.plain") x=$(cat "$WORK/ratio.exact")
+        r=$(awk -v p="$p" -v x="$x" 'BEGIN { printf "%.3f", (p > 0 ? x / p : 0) }')
+        echo "$PROV,$s,$L,$SIZE,$RATIO_PAIRS,$p,$x,$r" >>"$RAT"
+        echo "  ratio $s levels $L std: plain $p ms, --exact $x ms: ${r}x ($RATIO_PAIRS pairs)"
     done
 fi
 

@@ -37,6 +37,23 @@ $P,b,8,1024,0.1,100
 $P,b,9,1024,0.2,150
 $P,b,10,1024,0.4,120
 CSV
+cat >"$R/render.csv" <<CSV
+$H,scene,levels,view,size,refine,ms_per_frame,mrays_s,depth_mean_vox,depth_p99_vox,depth_max_vox,hitmiss_frac,normal_mean_deg,normal_p99_deg,normal_max_deg,nan_pixels
+$P,blobs_a,10,std,1024,plain,41.6,25.2,3.74,13.2,20,0.00163,0.41,2.25,3,0
+$P,blobs_a,10,std,1024,exact,82.3,12.7,0,0,0,0,2e-07,2.09e-06,3e-06,0
+$P,csg,10,std,1024,plain,84.7,12.4,2.13,8.67,9,0.00223,0.53,1.55,2,0
+$P,csg,10,std,1024,exact,145.5,7.2,0,0,0,0,1e-07,1.21e-06,2e-06,0
+CSV
+cat >"$R/refcast.csv" <<CSV
+$H,scene,view,size,ms,mrays_s
+$P,blobs_a,std,1024,1410,0.74
+$P,csg,std,1024,936,1.12
+CSV
+# the ratio section's alternating frames replace the main table's for blobs_a
+cat >"$R/exactratio.csv" <<CSV
+$H,scene,levels,size,pairs,plain_ms,exact_ms,ratio
+$P,blobs_a,10,1024,9,40.0,70.0,1.750
+CSV
 printf 'before\n<!-- bench:begin -->\nold\n<!-- bench:end -->\nafter\n' >"$T/README.md"
 expect_exit 0 sh "$ROOT/bench/report.sh" "$R" "$T/README.md"
 M="$T/README.md"
@@ -57,6 +74,8 @@ has "These rows: cpu (2 cores), 2026-12-05T10:00Z, commit def5678."
 has "| blobs_b | 9 | 954671 | 828476 | 1.400 ✗ | 0 ✓ | 0.032 / 0.172 / 0.54 | 0.0020 / 0.0039 |"
 has "| cube | 9 | 0 / 0 | 0.000 | 7e-07 / 1.2e-06 / 1.2e-06 | 0 | 10.8 | 24 | all met ✓ |"
 has "| plate | 10 | 0.002 / 0.5 | 0.100 | 0.1 / 0.2 / 3 | 2 | 15.6 | 43 | ✗ mean p99 hit/miss normal NaN |"
+has "| blobs_a | 10 | 1024² | 40.0 | 70.0 | 1.75 ✗ | 1.5x | 1410 | 20.1 |"
+has "| csg | 10 | 1024² | 84.7 | 145.5 | 1.72 ✓ | 2x | 936 | 6.4 |"
 has "| a | 300.0 | 200.0 | 250.0 | 9 |"
 has "| b | 100.0 | 150.0 | 120.0 | 8 |"
 grep -qF "The fastest level is 9 for a and 8 for b; at \`--levels 10\` a frame takes on average 1.23x" "$M" ||
