@@ -73,6 +73,7 @@ pair), not from the main table's separate runs."
     echo
     echo "\`--exact\` against the paper's rule and the exact interval caster, standard view"
     echo "(targets: at most 1.5x the paper's rule on \`blobs_a\`, 2x on \`csg\`; ✓ met, ✗ not met).$ratio_note"
+    has exactratio && own_run exactratio
     echo
     rf="$RES/exactratio.csv"; [ -f "$rf" ] || rf=/dev/null
     awk -F, "$AWKLIB"'
