@@ -152,7 +152,7 @@ typedef struct worker {
     tape_ilanes *ilslots;  /* the lane interval evaluator's scratch */
     tape_idual_lanes *iglslots; /* the lane interval gradient evaluator's */
     tape_ilanes *coarse_slots; /* [(levels + 2) * max_len], children_may_cross's, or NULL
-                                  (a long tape: cell_test_surviving alone) */
+                                  (over COARSE_LANES_BUDGET: cell_test_surviving alone) */
     tape_insn *own_insn;   /* [8 * tape_total]: child_prune's tapes, with coarse_slots */
     tape_const *own_konst; /* [8 * konst_total] */
     uint32_t *scratch;
@@ -196,9 +196,10 @@ typedef struct child_boxes child_boxes; /* rasterize/cell_geometry.h */
 unsigned cell_test_surviving(worker *wk, unsigned pidx, unsigned depth, const uint64_t cell[3],
                              interval box[3], double centre[3]);
 
-/* The longest tape whose children_may_cross lanes a worker keeps: 128
- * bytes an instruction at each depth. */
-#define COARSE_LANES_MAX_LEN 1024
+/* What a worker may spend on children_may_cross's lanes, kept for every
+ * depth (128 bytes an instruction and a depth): a longer tape or a deeper
+ * tree keeps the scalar test (cell_test_surviving). */
+#define COARSE_LANES_BUDGET (1u << 20)
 
 /* The children of a node above the mean-value levels, tested together
  * (children_may_cross) and taken one at a time (child_take). */

@@ -30,7 +30,8 @@ int worker_init(worker *wk, const build_ctx *c)
     wk->lslots = malloc(len * sizeof *wk->lslots);
     wk->ilslots = malloc(len * sizeof *wk->ilslots);
     wk->iglslots = malloc(len * sizeof *wk->iglslots);
-    if (len <= COARSE_LANES_MAX_LEN) { /* (a depth's lanes kept while its subtree is built) */
+    const int lanes = depths * len * sizeof *wk->coarse_slots <= COARSE_LANES_BUDGET;
+    if (lanes) { /* (a depth's lanes kept while its subtree is built) */
         wk->coarse_slots = malloc(depths * len * sizeof *wk->coarse_slots);
         wk->own_insn = malloc(8 * (c->tape_total ? c->tape_total : 1) * sizeof *wk->own_insn);
         wk->own_konst = malloc(8 * (c->konst_total ? c->konst_total : 1) * sizeof *wk->own_konst);
@@ -46,7 +47,7 @@ int worker_init(worker *wk, const build_ctx *c)
         wk->kinked[s] = tape_has_kink(c->full[s]);
     }
     wk->nact[0] = c->nsurf;
-    if (len <= COARSE_LANES_MAX_LEN && (!wk->coarse_slots || !wk->own_insn || !wk->own_konst))
+    if (lanes && (!wk->coarse_slots || !wk->own_insn || !wk->own_konst))
         return -1;
     return 0;
 }
