@@ -162,7 +162,7 @@ if want ratio; then
     for s in blobs_a csg; do
         oct="$WORK/ratio.oct" L=$RATIO_LEVELS
         "$BIN/rasterize" "scenes/$s.scene" -o "$oct" --levels "$L" -q
-        set -- $(NVIEWS=1 views "scenes/$s.scene")
+        set -- $(views "scenes/$s.scene" | head -n 1) # the standard view
         vf="$WORK/ratio.views"; : >"$vf"
         i=0
         while [ $i -le "$RATIO_PAIRS" ]; do
