@@ -208,7 +208,7 @@ typedef struct coarse_children {
     interval box[8][3];
     double centre[8][3];
     unsigned flags[8];
-    uint8_t lane[8], slot_lane[8]; /* a lane's child, a child's lane */
+    uint8_t slot_lane[8];  /* a child's lane */
     tape tape[8];          /* child_prune's */
     uint8_t kinked[8];
 } coarse_children;
@@ -223,9 +223,10 @@ uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_chil
  * its lists and pruned tape at index depth + 2. */
 void child_take(worker *wk, unsigned depth, const coarse_children *cc, unsigned i);
 /* Child i's pruned tape as child_take makes it, into cc->tape[i] (and
- * cc->kinked[i]), its instructions in the worker's slot i for them: the
- * children of one node at a time, such as the mean-value levels' first
- * nodes, whose forms are then made together. */
+ * cc->kinked[i]), its instructions in the worker's slot i for them, which
+ * the next node's child_prune overwrites: only for children whose subtrees
+ * prune no further, the mean-value levels' first nodes (their forms are
+ * then made together). */
 void child_prune(worker *wk, unsigned depth, coarse_children *cc, unsigned i);
 
 /* The tapes the records of the voxels under the node (lists at index idx,

@@ -343,9 +343,10 @@ uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_chil
     const tape *t = &wk->tapes[depth + 1];
     interval box[8][3], out[8];
     unsigned fl[8], n = 0;
+    uint8_t child[8]; /* a lane's */
     for (unsigned m = want; m; m &= m - 1) {
         const unsigned i = (unsigned)__builtin_ctz(m);
-        cc->lane[n] = (uint8_t)i;
+        child[n] = (uint8_t)i;
         n += (unsigned)cell_box(c, depth + 1, cc->cell[i], box[n], cc->centre[i]);
     }
     if (!n)
@@ -354,7 +355,7 @@ uint8_t children_may_cross(worker *wk, unsigned depth, uint8_t want, coarse_chil
     tape_eval_interval_lanes(t, n, (const interval(*)[3])box, out, fl, sl);
     uint8_t live = 0;
     for (unsigned l = 0; l < n; l++) {
-        const unsigned i = cc->lane[l];
+        const unsigned i = child[l];
         memcpy(cc->box[i], box[l], sizeof box[l]);
         cc->flags[i] = fl[l];
         cc->slot_lane[i] = (uint8_t)l;
