@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/expr/tape_err_cell.h"
 #include "rasterize/build_internal.h"
 
 #define TASK_DEPTH 3          /* 8^3 = 512 subtrees: enough to balance two cores */
@@ -139,6 +140,32 @@ void build_writer_params(const scene *sc, unsigned levels, float palette[3 * OCT
     wp->palette = palette;
 }
 
+/* For each surface whose full tape has no kink (abs, min, max), an
+ * a-priori bound on the rounding error of its value in double at every
+ * point of the cube (tape_err_cell), into c->centre_ev; NaN for the others
+ * and where none is made. The centred re-tests take f at a voxel centre as
+ * that value within it (centre_err, rasterize/voxel_retest.c). -1 when
+ * memory runs out. */
+static int centre_rounding_bounds(build_ctx *c)
+{
+    c->centre_ev = malloc(c->nsurf * sizeof *c->centre_ev);
+    tape_idual *g = malloc((c->max_len ? c->max_len : 1) * sizeof *g);
+    tape_cerr *e = malloc((c->max_len ? c->max_len : 1) * sizeof *e);
+    const int ok = c->centre_ev && g && e;
+    for (unsigned s = 0; ok && s < c->nsurf; s++) {
+        interval cube[3];
+        for (int k = 0; k < 3; k++)
+            cube[k] = (interval){c->origin[k], c->origin[k] + c->edge};
+        tape_cell_err ce;
+        c->centre_ev[s] = NAN;
+        if (!tape_has_kink(c->full[s]) && tape_err_cell(c->full[s], cube, &ce, g, e))
+            c->centre_ev[s] = ce.ev;
+    }
+    free(g);
+    free(e);
+    return ok ? 0 : -1;
+}
+
 int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p)
 {
     memset(c, 0, sizeof *c);
@@ -167,7 +194,7 @@ int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p)
         c->konst_off[s] = c->konst_total;
         c->konst_total += c->full[s]->nconst + c->full[s]->n;
     }
-    return 0;
+    return centre_rounding_bounds(c);
 }
 
 void build_ctx_free(build_ctx *c)
@@ -175,6 +202,7 @@ void build_ctx_free(build_ctx *c)
     free(c->full);
     free(c->tape_off);
     free(c->konst_off);
+    free(c->centre_ev);
     memset(c, 0, sizeof *c);
 }
 

@@ -83,6 +83,8 @@ typedef struct build_ctx {
     uint32_t *konst_off;       /* offset of each surface's pruned constant pool */
     uint32_t konst_total;      /* sum of (constants + instructions) over the surfaces */
     uint32_t max_len;
+    double *centre_ev;         /* [nsurf]: a bound on the rounding of each full tape's value in
+                                  double anywhere in the cube, or NaN (centre_rounding_bounds) */
     const build_shard *shard;  /* NULL: the whole grid */
 } build_ctx;
 
@@ -248,7 +250,8 @@ typedef struct retest_item {
  * the lane interval evaluator (one alone with the scalar one); drop[j]
  * receives 1 when cell j is proved empty of the surface. centred_form_drops:
  * the mean-value form centred on each voxel, f([c]) + G . (box - c), G the
- * parent's gradient enclosure and fd f(c) in double (cell_test.c).
+ * parent's gradient enclosure and fd f(c) in double (cell_test.c); where ev
+ * is not NaN (centre_err), fd +- ev stands for f([c]), no evaluation.
  * plain_test_drops: the plain interval test over each cell's box (no point of
  * the surface where f is defined), on voxels or on a node's children. Same
  * decisions and counts as testing the cells one by one. */
@@ -258,8 +261,8 @@ typedef struct retest_item {
  * evaluated (an fd of NaN keeps it). */
 uint8_t centred_form_cannot_exclude(interval fc, const interval G[3], const double c[3],
                                     const child_boxes *cb, uint8_t cand);
-void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
-                        unsigned n, uint8_t *drop);
+void centred_form_drops(worker *wk, const tape *t, const interval G[3], double ev,
+                        const retest_item *it, unsigned n, uint8_t *drop);
 void plain_test_drops(worker *wk, const tape *t, unsigned s, const retest_item *it, unsigned n,
                       uint8_t *drop);
 

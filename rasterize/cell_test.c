@@ -40,7 +40,9 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
  * (and the half-width of pruned constants, a thousandth of f's spread over a
  * voxel) of fd, and the voxel is kept. Skipping a test only keeps a voxel, so
  * soundness does not rest on the margin; it only makes the skip agree with
- * the full test (docs/perf-log.md, rasterize). */
+ * the full test (docs/perf-log.md, rasterize). Where an a-priori bound on
+ * fd's rounding stands for the evaluation (centre_err), no evaluation runs:
+ * f([c]) is fd widened by it. */
 #define RETEST_MARGIN 0.03125
 
 /* Whether the form centred on the voxel may exclude 0 at all: 0 when fd lies
@@ -130,9 +132,18 @@ static void lanes_or_one(worker *wk, const tape *t, unsigned n, interval box[][3
         tape_eval_interval_lanes(t, n, (const interval(*)[3])box, out, fl, wk->ilslots);
 }
 
-void centred_form_drops(worker *wk, const tape *t, const interval G[3], const retest_item *it,
-                        unsigned n, uint8_t *drop)
+void centred_form_drops(worker *wk, const tape *t, const interval G[3], double ev,
+                        const retest_item *it, unsigned n, uint8_t *drop)
 {
+    if (ev == ev) { /* f(c) within ev of fd: the form with no evaluation */
+        for (unsigned j = 0; j < n; j++) {
+            const interval fc = {interval_next_down(it[j].fd - ev),
+                                 interval_next_up(it[j].fd + ev)};
+            drop[j] = (uint8_t)(centred_form_may_exclude(G, it[j].box, it[j].centre, it[j].fd) &&
+                                centred_form_excludes(fc, 0, G, it[j].box, it[j].centre));
+        }
+        return;
+    }
     interval pts[TAPE_LANES][3], out[TAPE_LANES];
     unsigned fl[TAPE_LANES], lane[TAPE_LANES], m = 0;
     for (unsigned j = 0; j < n; j++) {

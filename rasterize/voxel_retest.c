@@ -2,6 +2,8 @@
  * one leaf-parent at a time or a batch pooled (see voxel_retest.h). */
 #include "rasterize/voxel_retest.h"
 
+#include <math.h>
+
 /* f and its gradient at n voxel centres (tape_eval_grad_lanes). With
  * --shell-only and one surface only f is wanted (the centred re-test's
  * skip; no record, no choice of surface): the value evaluator, the same
@@ -25,6 +27,21 @@ static void centre_values(worker *wk, const tape *t, unsigned n, const double *x
 static const tape *centre_tape(const worker *wk, const tape *pruned, unsigned s)
 {
     return wk->c->par->shell_only && wk->c->nsurf == 1 ? pruned : &wk->rec[s];
+}
+
+/* The bound that stands for the centred re-test's evaluation of f at the
+ * centres of surface s's candidates under a node with tape t, or NaN. The
+ * centres' values come from the centre tape: the full tape (the record
+ * tape, which a tape with no kink keeps whole) or t. Where t froze no term
+ * into a constant (its pool is the full tape's) and the full tape has no
+ * kink, t is the full tape less dead code, the same bits; the full tape's
+ * bound over the cube (build_ctx's centre_ev) holds for both, and the form,
+ * whose G is t's gradient enclosure, holds f. (A frozen term's change
+ * across the voxel is in neither G nor f at one point: there the interval
+ * evaluation of t at the centre, which spans the constant, is run.) */
+static double centre_err(const worker *wk, unsigned s, const tape *t)
+{
+    return t->nconst == wk->c->full[s]->nconst ? wk->c->centre_ev[s] : NAN;
 }
 
 /* With --shell-only and one surface, f at a child's centre serves only the
@@ -100,7 +117,8 @@ void leaf_retests(worker *wk, unsigned depth, const uint8_t *ok, const uint8_t *
                 it[n++] = r;
             }
         const tape *t = &wk->tapes[(size_t)pidx * ns + s];
-        centred_form_drops(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], it, n, drop);
+        centred_form_drops(wk, t, &wk->grad[((size_t)pidx * ns + s) * 3], centre_err(wk, s, t),
+                           it, n, drop);
         for (unsigned j = 0; j < n; j++) {
             if (drop[j])
                 centred[k] |= (uint8_t)(1u << child[j]);
@@ -202,7 +220,7 @@ void batch_retests(worker *wk, unsigned pidx, leaf_parent *lp, unsigned nb)
             it[nit++] = r;
         }
     if (nfd) { /* (the guard also shows GCC that fit is written before it is read) */
-        centred_form_drops(wk, t, G, fit, nfd, fdrop);
+        centred_form_drops(wk, t, G, centre_err(wk, 0, t), fit, nfd, fdrop);
         for (unsigned j = 0; j < nfd; j++)
             drop[fdj[j]] = fdrop[j];
     }

@@ -85,17 +85,20 @@ static int64_t find_voxel(const oct_tree *t, uint64_t x, uint64_t y, uint64_t z)
     return (int64_t)node;
 }
 
-/* Every voxel whose (k+1)^3 sample lattice (corners included) holds a sign
- * change of any surface, or an exact zero, must be in the tree. Samples
- * outside the scene's bounds do not count: the surface lives in them. */
-static void check_no_voxel_lost(const char *path, unsigned levels, unsigned k, build_method method)
+/* Every voxel of the window [lo, lo + w)^3 (in voxels) whose (k+1)^3
+ * sample lattice (corners included) holds a sign change of any surface, or
+ * an exact zero, must be in the tree. Samples outside the scene's bounds do
+ * not count: the surface lives in them. */
+static void check_window_no_voxel_lost(const char *path, unsigned levels, unsigned k,
+                                       build_method method, const unsigned lo[3], unsigned w)
 {
     scene *sc = test_scene_load(path);
     built b;
     build_in_memory(sc, levels, method, 2, &b);
     double origin[3], edge;
     build_cube(sc, origin, &edge);
-    unsigned n = 1u << levels, r = n * k + 1;
+    unsigned n = 1u << levels, r = w * k + 1;
+    assert_true(lo[0] + w <= n && lo[1] + w <= n && lo[2] + w <= n);
     double *slots = malloc(sizeof(double) * 65536);
     signed char *sign = malloc((size_t)r * r * r);
     assert_non_null(slots);
@@ -107,8 +110,10 @@ static void check_no_voxel_lost(const char *path, unsigned levels, unsigned k, b
         for (unsigned z = 0; z < r; z++)
             for (unsigned y = 0; y < r; y++)
                 for (unsigned x = 0; x < r; x++) {
-                    double p[3] = {origin[0] + edge * x / (r - 1), origin[1] + edge * y / (r - 1),
-                                   origin[2] + edge * z / (r - 1)};
+                    const unsigned q[3] = {lo[0] * k + x, lo[1] * k + y, lo[2] * k + z};
+                    double p[3];
+                    for (int a = 0; a < 3; a++)
+                        p[a] = origin[a] + edge * q[a] / ((double)n * k);
                     signed char sg = 2; /* 2: does not count */
                     if (p[0] <= sc->hi[0] && p[1] <= sc->hi[1] && p[2] <= sc->hi[2]) {
                         double f = tape_eval(t, p[0], p[1], p[2], slots);
@@ -116,9 +121,9 @@ static void check_no_voxel_lost(const char *path, unsigned levels, unsigned k, b
                     }
                     sign[((size_t)z * r + y) * r + x] = sg;
                 }
-        for (unsigned vz = 0; vz < n; vz++)
-            for (unsigned vy = 0; vy < n; vy++)
-                for (unsigned vx = 0; vx < n; vx++) {
+        for (unsigned vz = 0; vz < w; vz++)
+            for (unsigned vy = 0; vy < w; vy++)
+                for (unsigned vx = 0; vx < w; vx++) {
                     int pos = 0, neg = 0, zero = 0;
                     for (unsigned dz = 0; dz <= k; dz++)
                         for (unsigned dy = 0; dy <= k; dy++)
@@ -130,19 +135,28 @@ static void check_no_voxel_lost(const char *path, unsigned levels, unsigned k, b
                             }
                     if ((pos && neg) || zero) {
                         must++;
-                        if (find_voxel(b.tree, vx, vy, vz) < 0)
+                        if (find_voxel(b.tree, lo[0] + vx, lo[1] + vy, lo[2] + vz) < 0)
                             fail_msg("%s: levels %u: voxel %u,%u,%u of surface %zu lost", path,
-                                     levels, vx, vy, vz, s);
+                                     levels, lo[0] + vx, lo[1] + vy, lo[2] + vz, s);
                     }
                 }
     }
     /* The shell stays thin: the kept voxels are not many more than the ideal. */
-    print_message("%s: levels %u: %llu voxels kept, %llu required by sign changes\n", path, levels,
-                  (unsigned long long)b.st.voxels, (unsigned long long)must);
+    print_message("%s: levels %u: %llu voxels kept, %llu required by sign changes in a window "
+                  "of %u^3\n", path, levels, (unsigned long long)b.st.voxels,
+                  (unsigned long long)must, w);
+    assert_true(must > 0); /* (a window the surface crosses) */
     free(sign);
     free(slots);
     built_free(&b);
     scene_free(sc);
+}
+
+/* The same over the whole grid. */
+static void check_no_voxel_lost(const char *path, unsigned levels, unsigned k, build_method method)
+{
+    static const unsigned origin[3] = {0, 0, 0};
+    check_window_no_voxel_lost(path, levels, k, method, origin, 1u << levels);
 }
 
 static void for_each_scene(void (*fn)(const char *path))
@@ -185,6 +199,28 @@ static void test_lipschitz_method_loses_nothing(void **state)
 {
     (void)state;
     for_each_scene(lossless_lipschitz);
+}
+
+/* From levels 8 on the leaf-parents' candidates take the form centred on
+ * each voxel (MEAN_VALUE_ALONE_DEPTH): f at the centre from the a-priori
+ * rounding bound (blobs_a: no kink, nothing frozen), from the interval
+ * evaluation at the centre (manyblobs: far blobs frozen into constants;
+ * csg: kinks). A window of 48^3 voxels about a point of the surface at
+ * levels 8 (centre: in voxels), sampled 3 times finer. */
+static void test_retested_levels_lose_nothing(void **state)
+{
+    (void)state;
+    static const struct { const char *path; unsigned centre[3]; } cases[] = {
+        {"scenes/blobs_a.scene", {143, 200, 200}},
+        {"scenes/manyblobs.scene", {68, 74, 151}},
+        {"scenes/csg.scene", {221, 180, 163}},
+    };
+    const unsigned w = SANITIZED ? 32 : 48;
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+        const unsigned lo[3] = {cases[c].centre[0] - w / 2, cases[c].centre[1] - w / 2,
+                                cases[c].centre[2] - w / 2};
+        check_window_no_voxel_lost(cases[c].path, 8, SANITIZED ? 2 : 3, BUILD_INTERVAL, lo, w);
+    }
 }
 
 static void test_output_independent_of_threads(void **state)
@@ -429,6 +465,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_interval_method_loses_nothing),
         cmocka_unit_test(test_lipschitz_method_loses_nothing),
+        cmocka_unit_test(test_retested_levels_lose_nothing),
         cmocka_unit_test(test_output_independent_of_threads),
         cmocka_unit_test(test_shell_only_same_voxels),
         cmocka_unit_test(test_sphere_normals_and_offsets),

@@ -7,7 +7,9 @@
  * interval), and the gradient bound holds; near the surface (cancellation)
  * the bound is no wider than a small multiple of the per-point one
  * (tape_eval_dir_err) at the same point; it gives up where a kink, a
- * domain edge or a pole is within the box. */
+ * domain edge or a pole is within the box. The rasterizer's use, one bound
+ * over the whole cube of a scene whose function has no kink, is checked on
+ * every example scene. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,7 +19,12 @@
 #include "common/expr/tape_dir.h"
 #include "common/expr/tape_err.h"
 #include "common/expr/tape_err_cell.h"
+#include "rasterize/build.h"
+#include "tests/scene_util.h"
 #include "tests/test_tape_util.h"
+
+#include <dirent.h>
+#include <string.h>
 #include "tests/tape_ref.h"
 
 static tape_idual gs[MAXSLOTS];
@@ -192,12 +199,56 @@ static void test_gives_up(void **state)
     assert_int_equal(ty.bounded, ty.boxes);
 }
 
+/* The rasterizer's centred re-test takes one bound per surface over the
+ * whole cube around the scene's bounds (build_cube) where the function has
+ * no abs, min or max (rasterize/build.c): on every example scene such a
+ * surface is bounded there, and the bound holds at random points of it. */
+static void test_whole_cube(void **state)
+{
+    (void)state;
+    DIR *d = opendir("scenes");
+    assert_non_null(d);
+    unsigned checked = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        const size_t len = strlen(e->d_name);
+        if (len < 7 || strcmp(e->d_name + len - 6, ".scene") != 0)
+            continue;
+        char path[512];
+        snprintf(path, sizeof path, "scenes/%s", e->d_name);
+        scene *sc = test_scene_load(path);
+        double origin[3], edge;
+        build_cube(sc, origin, &edge);
+        interval cube[3];
+        for (int k = 0; k < 3; k++)
+            cube[k] = (interval){origin[k], origin[k] + edge};
+        for (size_t i = 0; i < sc->nsurfaces; i++) {
+            const tape *t = &sc->surfaces[i].tape;
+            int kink = 0;
+            for (uint32_t j = 0; j < t->n; j++)
+                kink |= t->insn[j].op == TAPE_ABS || t->insn[j].op == TAPE_MIN ||
+                        t->insn[j].op == TAPE_MAX;
+            if (kink)
+                continue;
+            tally ty = {0, 0, 0, 0.0};
+            check_box(path, t, cube, 2000 / SCALE, &ty);
+            checked += ty.bounded;
+            print_message("%s surface %zu: %s over the whole cube\n", path, i,
+                          ty.bounded ? "bounded" : "no bound");
+        }
+        scene_free(sc);
+    }
+    closedir(d);
+    assert_true(checked >= 5); /* (the blobs, sphere, torus, manyblobs at least) */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_scenes),
         cmocka_unit_test(test_tight),
         cmocka_unit_test(test_gives_up),
+        cmocka_unit_test(test_whole_cube),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
