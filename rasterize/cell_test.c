@@ -41,22 +41,39 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
  * voxel) of fd, and the voxel is kept. Skipping a test only keeps a voxel, so
  * soundness does not rest on the margin; it only makes the skip agree with
  * the full test (docs/perf-log.md, rasterize). Where an a-priori bound on
- * fd's rounding stands for the evaluation (centre_err), no evaluation runs:
+ * fd's rounding stands for the evaluation (centre_err), none runs:
  * f([c]) is fd widened by it. */
 #define RETEST_MARGIN 0.03125
+
+/* G . (box - c) in plain double: its ends (wlo, whi) and, with mag, the
+ * magnitude of its terms; the margins below cover the rounding. */
+static inline void centred_products(const interval G[3], const interval box[3],
+                                    const double centre[3], double *wlo, double *whi,
+                                    double *mag)
+{
+    double lo = 0.0, hi = 0.0, mg = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double rl = box[k].lo - centre[k], rh = box[k].hi - centre[k];
+        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
+        const double l = min2(min2(p1, p2), min2(p3, p4)), h = max2(max2(p1, p2), max2(p3, p4));
+        lo += l;
+        hi += h;
+        if (mag)
+            mg += fabs(l) + fabs(h);
+    }
+    *wlo = lo;
+    *whi = hi;
+    if (mag)
+        *mag = mg;
+}
 
 /* Whether the form centred on the voxel may exclude 0 at all: 0 when fd lies
  * too far inside the width of G . (box - c) (see above). */
 static int centred_form_may_exclude(const interval G[3], const interval box[3],
                                     const double centre[3], double fd)
 {
-    double wlo = 0.0, whi = 0.0; /* G . (box - c) in plain double: the margin covers rounding */
-    for (int k = 0; k < 3; k++) {
-        double rl = box[k].lo - centre[k], rh = box[k].hi - centre[k];
-        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
-        wlo += min2(min2(p1, p2), min2(p3, p4));
-        whi += max2(max2(p1, p2), max2(p3, p4));
-    }
+    double wlo, whi;
+    centred_products(G, box, centre, &wlo, &whi, NULL);
     double m = RETEST_MARGIN * (whi - wlo);
     return !(fd + m + wlo <= 0.0 && fd - m + whi >= 0.0); /* false on NaN or inf */
 }
@@ -132,15 +149,36 @@ static void lanes_or_one(worker *wk, const tape *t, unsigned n, interval box[][3
         tape_eval_interval_lanes(t, n, (const interval(*)[3])box, out, fl, wk->ilslots);
 }
 
+/* centred_form_excludes(fc, fl, ...), first from the products of G with
+ * the voxel's offsets in plain double (centred_products): where the form's
+ * ends clear 0 by far more than their rounding, or straddle it so, the
+ * outward-rounded form agrees (form_decide's argument); only the rest take
+ * centred_form_excludes itself. */
+static int centred_form_decide(interval fc, unsigned fl, const interval G[3],
+                               const interval box[3], const double centre[3])
+{
+    double wlo, whi, mag;
+    centred_products(G, box, centre, &wlo, &whi, &mag);
+    const double lo = fc.lo + wlo, hi = fc.hi + whi;
+    const double margin = 0x1p-44 * (mag + fabs(fc.lo) + fabs(fc.hi)) + 0x1p-1000;
+    if (!fl && (lo > margin || hi < -margin))
+        return 1;
+    if (lo <= -margin && hi >= margin)
+        return 0;
+    return centred_form_excludes(fc, fl, G, box, centre); /* (also NaN) */
+}
+
 void centred_form_drops(worker *wk, const tape *t, const interval G[3], double ev,
                         const retest_item *it, unsigned n, uint8_t *drop)
 {
     if (ev == ev) { /* f(c) within ev of fd: the form with no evaluation */
         for (unsigned j = 0; j < n; j++) {
+            drop[j] = 0;
+            if (!centred_form_may_exclude(G, it[j].box, it[j].centre, it[j].fd))
+                continue;
             const interval fc = {interval_next_down(it[j].fd - ev),
                                  interval_next_up(it[j].fd + ev)};
-            drop[j] = (uint8_t)(centred_form_may_exclude(G, it[j].box, it[j].centre, it[j].fd) &&
-                                centred_form_excludes(fc, 0, G, it[j].box, it[j].centre));
+            drop[j] = (uint8_t)centred_form_decide(fc, 0, G, it[j].box, it[j].centre);
         }
         return;
     }
@@ -158,8 +196,8 @@ void centred_form_drops(worker *wk, const tape *t, const interval G[3], double e
             lanes_or_one(wk, t, m, pts, out, fl);
             wk->st.interval_evals += m;
             for (unsigned l = 0; l < m; l++)
-                drop[lane[l]] = (uint8_t)centred_form_excludes(out[l], fl[l], G, it[lane[l]].box,
-                                                               it[lane[l]].centre);
+                drop[lane[l]] = (uint8_t)centred_form_decide(out[l], fl[l], G, it[lane[l]].box,
+                                                             it[lane[l]].centre);
             m = 0;
         }
     }
