@@ -16,15 +16,15 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <dirent.h>
+#include <string.h>
+
 #include "common/expr/tape_dir.h"
 #include "common/expr/tape_err.h"
 #include "common/expr/tape_err_cell.h"
 #include "rasterize/build.h"
 #include "tests/scene_util.h"
 #include "tests/test_tape_util.h"
-
-#include <dirent.h>
-#include <string.h>
 #include "tests/tape_ref.h"
 
 static tape_idual gs[MAXSLOTS];
@@ -201,8 +201,9 @@ static void test_gives_up(void **state)
 
 /* The rasterizer's centred re-test takes one bound per surface over the
  * whole cube around the scene's bounds (build_cube) where the function has
- * no abs, min or max (rasterize/build.c): on every example scene such a
- * surface is bounded there, and the bound holds at random points of it. */
+ * no abs, min or max (rasterize/build.c): on the example scenes such
+ * surfaces are bounded there (at least five; not the torus, whose sqrt
+ * reaches 0), and the bound holds at random points of the cube. */
 static void test_whole_cube(void **state)
 {
     (void)state;
