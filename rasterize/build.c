@@ -152,10 +152,10 @@ static int centre_rounding_bounds(build_ctx *c)
     tape_idual *g = malloc((c->max_len ? c->max_len : 1) * sizeof *g);
     tape_cerr *e = malloc((c->max_len ? c->max_len : 1) * sizeof *e);
     const int ok = c->centre_ev && g && e;
+    interval cube[3];
+    for (int k = 0; k < 3; k++)
+        cube[k] = (interval){c->origin[k], c->origin[k] + c->edge};
     for (unsigned s = 0; ok && s < c->nsurf; s++) {
-        interval cube[3];
-        for (int k = 0; k < 3; k++)
-            cube[k] = (interval){c->origin[k], c->origin[k] + c->edge};
         tape_cell_err ce;
         c->centre_ev[s] = NAN;
         if (!tape_has_kink(c->full[s]) && tape_err_cell(c->full[s], cube, &ce, g, e))

@@ -45,6 +45,19 @@ static int eval_at_centre(worker *wk, const tape *t, const double centre[3], int
  * f([c]) is fd widened by it. */
 #define RETEST_MARGIN 0.03125
 
+/* The ends of g x off in plain double (the forms' terms). */
+static inline void form_product(interval g, interval off, double *lo, double *hi)
+{
+    double p1 = g.lo * off.lo, p2 = g.lo * off.hi, p3 = g.hi * off.lo, p4 = g.hi * off.hi;
+    *lo = min2(min2(p1, p2), min2(p3, p4));
+    *hi = max2(max2(p1, p2), max2(p3, p4));
+}
+
+/* Where a form's end summed in plain double clears 0 by more than this,
+ * terms of total magnitude mag, its outward-rounded sum lies on the same
+ * side of 0 (the argument: form_decide, below). */
+static inline double form_margin(double mag) { return 0x1p-44 * mag + 0x1p-1000; }
+
 /* G . (box - c) in plain double: its ends (wlo, whi) and, with mag, the
  * magnitude of its terms; the margins below cover the rounding. */
 static inline void centred_products(const interval G[3], const interval box[3],
@@ -53,9 +66,9 @@ static inline void centred_products(const interval G[3], const interval box[3],
 {
     double lo = 0.0, hi = 0.0, mg = 0.0;
     for (int k = 0; k < 3; k++) {
-        double rl = box[k].lo - centre[k], rh = box[k].hi - centre[k];
-        double p1 = G[k].lo * rl, p2 = G[k].lo * rh, p3 = G[k].hi * rl, p4 = G[k].hi * rh;
-        const double l = min2(min2(p1, p2), min2(p3, p4)), h = max2(max2(p1, p2), max2(p3, p4));
+        const double rl = box[k].lo - centre[k], rh = box[k].hi - centre[k];
+        double l, h;
+        form_product(G[k], (interval){rl, rh}, &l, &h);
         lo += l;
         hi += h;
         if (mag)
@@ -69,8 +82,8 @@ static inline void centred_products(const interval G[3], const interval box[3],
 
 /* Whether the form centred on the voxel may exclude 0 at all: 0 when fd lies
  * too far inside the width of G . (box - c) (see above). */
-static int centred_form_may_exclude(const interval G[3], const interval box[3],
-                                    const double centre[3], double fd)
+static inline int centred_form_may_exclude(const interval G[3], const interval box[3],
+                                           const double centre[3], double fd)
 {
     double wlo, whi;
     centred_products(G, box, centre, &wlo, &whi, NULL);
@@ -151,16 +164,16 @@ static void lanes_or_one(worker *wk, const tape *t, unsigned n, interval box[][3
 
 /* centred_form_excludes(fc, fl, ...), first from the products of G with
  * the voxel's offsets in plain double (centred_products): where the form's
- * ends clear 0 by far more than their rounding, or straddle it so, the
- * outward-rounded form agrees (form_decide's argument); only the rest take
- * centred_form_excludes itself. */
+ * ends clear 0, or straddle it, by more than form_margin, the
+ * outward-rounded form agrees; only the rest take centred_form_excludes
+ * itself. */
 static int centred_form_decide(interval fc, unsigned fl, const interval G[3],
                                const interval box[3], const double centre[3])
 {
-    double wlo, whi, mag;
+    double wlo, whi, mag; /* (made again with mag: only for the few the filter lets through) */
     centred_products(G, box, centre, &wlo, &whi, &mag);
     const double lo = fc.lo + wlo, hi = fc.hi + whi;
-    const double margin = 0x1p-44 * (mag + fabs(fc.lo) + fabs(fc.hi)) + 0x1p-1000;
+    const double margin = form_margin(mag + fabs(fc.lo) + fabs(fc.hi));
     if (!fl && (lo > margin || hi < -margin))
         return 1;
     if (lo <= -margin && hi >= margin)
@@ -505,21 +518,13 @@ static int form_drops_exact(const interval *fc, const interval G[3], interval of
  * as these do; so where a sum's end clears 0 by far more than that (the
  * margin, and beyond flushed subnormals) the two agree on which side of 0
  * it lies. 0 (undecided) where an end is nearer 0, or a term is not
- * finite: then the caller runs form_drops_exact. */
-static void form_product(interval g, interval off, double *lo, double *hi)
-{
-    double p1 = g.lo * off.lo, p2 = g.lo * off.hi, p3 = g.hi * off.lo, p4 = g.hi * off.hi;
-    *lo = min2(min2(p1, p2), min2(p3, p4));
-    *hi = max2(max2(p1, p2), max2(p3, p4));
-}
-
-/* The decisions from the products' ends (plo, phi) and the magnitude of all
- * the terms (mag). */
+ * finite: then the caller runs form_drops_exact. Here the decisions from
+ * the products' ends (plo, phi) and the magnitude of all the terms (mag). */
 static int form_decide(interval fc, double plo[3][2], double phi[3][2], double mag, uint8_t *fx)
 {
     if (!(mag < INFINITY)) /* also NaN */
         return 0;
-    const double margin = 0x1p-44 * mag + 0x1p-1000;
+    const double margin = form_margin(mag);
     /* the comparisons combined without branches: which way each child goes
      * is data, and mispredicted branches on it were most of this loop's
      * time (docs/perf-log.md) */
