@@ -23,6 +23,8 @@ struct oct_writer {
     unsigned char *function; /* copy of the FUNCTION section, or NULL */
     int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
     int done; /* finish was called: the writer accepts nothing more */
+    oct_copy_fn copy; /* oct_writer_set_copy's, or NULL */
+    void *copy_ctx;
 };
 
 static int finite_unit(float v) { return isfinite(v) && v >= 0.0f && v <= 1.0f; }
@@ -144,14 +146,21 @@ static int put_nodes(const oct_writer *w, oct_sink *s)
         const oct_chunks *m = &w->masks[d];
         uint64_t base = 0, n = m->n;
         size_t fill = 0;
-        for (uint64_t g = 0; g < groups_of(n); g++) {
+        for (uint64_t g = 0, ng = groups_of(n); g < ng; g++) {
             unsigned char *rec = buf + 16 * fill;
             wr_u64le(rec, base);
-            for (unsigned k = 0; k < 8; k++) {
-                uint64_t i = 8 * g + k;
-                rec[8 + k] = i < n ? oct_chunks_at(m, i) : 0;
-                base += oct_popcount64(rec[8 + k]);
+            /* the group's eight masks, in one chunk (chunks hold whole groups) and
+               zeros past the depth's last node, copied and counted as one word */
+            const uint64_t i = 8 * g;
+            if (i + 8 <= n) {
+                memcpy(rec + 8, m->c[i >> OCT_CHUNK_BITS] + (i & (OCT_CHUNK - 1)), 8);
+            } else {
+                for (unsigned k = 0; k < 8; k++)
+                    rec[8 + k] = i + k < n ? oct_chunks_at(m, i + k) : 0;
             }
+            uint64_t masks;
+            memcpy(&masks, rec + 8, 8);
+            base += oct_popcount64(masks);
             if (++fill == CHUNK) {
                 if (oct_sink_put(s, buf, sizeof buf) != 0)
                     return -1;
@@ -289,7 +298,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             lay.crc[k] = oct_spool_crc(k == OCT_SEC_VOXELS ? &w->voxels : &w->surfaces);
             continue;
         }
-        oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0, 0};
+        oct_sink crc = {.crc = crc32_z(0, NULL, 0)};
         put_section(w, k, &crc);
         lay.crc[k] = (uint32_t)crc.crc;
     }
@@ -297,7 +306,8 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
 
     unsigned char h[OCT_HEADER_SIZE_1_1];
     build_header(w, &lay, h, hsize);
-    oct_sink s = {f, 0, 0, 1}; /* the CRCs are in the header already */
+    /* the CRCs are in the header already */
+    oct_sink s = {.f = f, .no_crc = 1, .copy = w->copy, .copy_ctx = w->copy_ctx};
     errno = 0;
     if (oct_sink_put(&s, h, hsize) != 0)
         return OCT_EIO;
@@ -315,6 +325,12 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
     if (bytes_written)
         *bytes_written = s.bytes;
     return OCT_OK;
+}
+
+void oct_writer_set_copy(oct_writer *w, oct_copy_fn fn, void *ctx)
+{
+    w->copy = fn;
+    w->copy_ctx = ctx;
 }
 
 void oct_writer_free(oct_writer *w)
