@@ -291,37 +291,6 @@ int atomic_file_write(atomic_file *af, const void *data, size_t n)
     return 0;
 }
 
-int64_t atomic_file_copy_from(atomic_file *af, int in_fd, uint64_t in_off, uint64_t len)
-{
-    if (fflush(af->fp) != 0)
-        return -1;
-    uint64_t done = 0;
-#ifdef __linux__
-    while (done < len) {
-        if (fault_check("write") != 0)
-            return -1;
-        loff_t from = (loff_t)(in_off + done);
-        const uint64_t k = len - done < ((uint64_t)1 << 30) ? len - done : (uint64_t)1 << 30;
-        const ssize_t r = copy_file_range(in_fd, &from, af->fd, NULL, (size_t)k, 0);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0)
-            break; /* not here, or the input ended: the caller's writes go on (and meet any
-                      error of the output themselves) */
-        done += (uint64_t)r;
-    }
-#else
-    (void)in_fd;
-    (void)in_off;
-#endif
-    return (int64_t)done;
-}
-
-int64_t atomic_file_copy_cb(void *af, int in_fd, uint64_t in_off, uint64_t len)
-{
-    return atomic_file_copy_from(af, in_fd, in_off, len);
-}
-
 static void release(atomic_file *af, int remove_tmp)
 {
     if (remove_tmp && af->made)

@@ -19,9 +19,8 @@
 #ifndef ATOMIC_FILE_H
 #define ATOMIC_FILE_H
 
-#include <stddef.h>
-#include <stdint.h>
 #include <stdio.h>
+#include <stddef.h>
 
 typedef struct atomic_file atomic_file;
 
@@ -36,19 +35,6 @@ FILE *atomic_file_stream(atomic_file *af);
 
 /* Writes n bytes, honouring the fault hook; returns 0 or -1 with errno. */
 int atomic_file_write(atomic_file *af, const void *data, size_t n);
-
-/* Copies up to len bytes of the file in_fd, from offset in_off, to the end
- * of what has been written (the stream flushed first) inside the kernel
- * (copy_file_range: no read into this process and write out of it; each
- * call counts as a write for the fault hook). Returns the bytes copied:
- * fewer than len, even 0, where the kernel cannot copy them here (another
- * file system, a pipe, a kernel without the call), the rest then being the
- * caller's to write; -1 with errno set when the flush or the hook fails. */
-int64_t atomic_file_copy_from(atomic_file *af, int in_fd, uint64_t in_off, uint64_t len);
-
-/* atomic_file_copy_from for a callback whose context is af (format/oct.h's
- * oct_copy_fn). */
-int64_t atomic_file_copy_cb(void *af, int in_fd, uint64_t in_off, uint64_t len);
 
 /* Flush, fsync, close, rename, fsync the directory; frees af. Returns 0, or
  * -1 with errno set and the temporary removed (target untouched). On error

@@ -285,19 +285,6 @@ oct_err oct_writer_add_masks(oct_writer *w, unsigned depth, const uint8_t *masks
  * OCT_FLAG_SHELL_ONLY (the records are not stored then, only counted). */
 oct_err oct_writer_add_voxels(oct_writer *w, const uint32_t *voxels, const uint8_t *surfaces,
                               size_t n);
-/* A copy of len bytes of the file in_fd, from offset in_off, to the end of
- * what the output stream has been given (its buffer flushed first), by a
- * means cheaper than reading them and writing them to the stream (the
- * kernel's copy_file_range). Returns the bytes copied, those from in_off
- * on: fewer than len, even 0, where it cannot copy them (the writer writes
- * the rest to the stream); -1 with errno set when the output failed. */
-typedef int64_t (*oct_copy_fn)(void *ctx, int in_fd, uint64_t in_off, uint64_t len);
-
-/* Lets finish move the bytes spooled to files (spool_dir) with fn (ctx
- * its first argument): the same bytes, without passing them through this
- * process. NULL (the default): every byte through the stream. */
-void oct_writer_set_copy(oct_writer *w, oct_copy_fn fn, void *ctx);
-
 /* Checks the counts agree (OCT_EUSAGE if not), computes bases and CRCs and
  * writes the whole file to `out`, checking every write (OCT_EIO, errno set).
  * Does not close `out`. Byte-identical output for identical input. */

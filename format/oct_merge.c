@@ -511,7 +511,7 @@ static oct_err write_whole(merge *m, FILE *f, uint64_t *bytes, uint8_t *const *t
     const int v11 = rd_u32le(m->head + OCT_OFF_FLAGS) != 0 || size[OCT_SEC_FUNCTION] != 0;
     const uint32_t hsize = v11 ? OCT_HEADER_SIZE_1_1 : OCT_HEADER_SIZE;
     const int nsec = v11 ? OCT_SEC_COUNT : OCT_SEC_COUNT_1_0;
-    sink s = {m, {.f = f}};
+    sink s = {m, {f, 0, 0, 0}};
     static const unsigned char zero[OCT_HEADER_SIZE_1_1];
     if (put(&s, zero, hsize) != 0)
         return OCT_EIO;

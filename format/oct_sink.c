@@ -22,22 +22,6 @@ int oct_sink_put(oct_sink *s, const void *data, size_t n)
     return 0;
 }
 
-int oct_sink_copy(oct_sink *s, int fd, uint64_t off, uint64_t len, uint64_t *done)
-{
-    *done = 0;
-    if (!s->copy || !s->f || !s->no_crc || len == 0)
-        return 0;
-    const int64_t r = s->copy(s->copy_ctx, fd, off, len);
-    if (r < 0) {
-        if (errno == 0)
-            errno = EIO;
-        return -1;
-    }
-    *done = (uint64_t)r < len ? (uint64_t)r : len;
-    s->bytes += *done;
-    return 0;
-}
-
 int oct_sink_pad_to(oct_sink *s, uint64_t target)
 {
     static const unsigned char zero[OCT_ALIGN];

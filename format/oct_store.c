@@ -169,10 +169,7 @@ int oct_spool_append(oct_spool *s, const void *data, size_t n)
 
 int oct_spool_put(const oct_spool *s, oct_sink *sink)
 {
-    uint64_t o; /* the file's bytes by the sink's copy where it has one, the rest read back */
-    if (oct_sink_copy(sink, s->fd, 0, s->on_disk, &o) != 0)
-        return -1;
-    while (o < s->on_disk) {
+    for (uint64_t o = 0; o < s->on_disk;) {
         const size_t k = s->on_disk - o < READ_BLOCK ? (size_t)(s->on_disk - o) : READ_BLOCK;
         const ssize_t r = pread(s->fd, s->buf, k, (off_t)o);
         if (r < 0 && errno == EINTR)

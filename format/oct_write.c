@@ -23,8 +23,6 @@ struct oct_writer {
     unsigned char *function; /* copy of the FUNCTION section, or NULL */
     int v11;  /* something of 1.1 is used: minor 1, header 320, six sections */
     int done; /* finish was called: the writer accepts nothing more */
-    oct_copy_fn copy; /* oct_writer_set_copy's, or NULL */
-    void *copy_ctx;
 };
 
 static int finite_unit(float v) { return isfinite(v) && v >= 0.0f && v <= 1.0f; }
@@ -298,7 +296,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
             lay.crc[k] = oct_spool_crc(k == OCT_SEC_VOXELS ? &w->voxels : &w->surfaces);
             continue;
         }
-        oct_sink crc = {.crc = crc32_z(0, NULL, 0)};
+        oct_sink crc = {NULL, crc32_z(0, NULL, 0), 0, 0};
         put_section(w, k, &crc);
         lay.crc[k] = (uint32_t)crc.crc;
     }
@@ -306,8 +304,7 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
 
     unsigned char h[OCT_HEADER_SIZE_1_1];
     build_header(w, &lay, h, hsize);
-    /* the CRCs are in the header already */
-    oct_sink s = {.f = f, .no_crc = 1, .copy = w->copy, .copy_ctx = w->copy_ctx};
+    oct_sink s = {f, 0, 0, 1}; /* the CRCs are in the header already */
     errno = 0;
     if (oct_sink_put(&s, h, hsize) != 0)
         return OCT_EIO;
@@ -325,12 +322,6 @@ oct_err oct_writer_finish(oct_writer *w, void *out_file, uint64_t *bytes_written
     if (bytes_written)
         *bytes_written = s.bytes;
     return OCT_OK;
-}
-
-void oct_writer_set_copy(oct_writer *w, oct_copy_fn fn, void *ctx)
-{
-    w->copy = fn;
-    w->copy_ctx = ctx;
 }
 
 void oct_writer_free(oct_writer *w)

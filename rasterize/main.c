@@ -223,7 +223,6 @@ static int write_output(oct_writer *w, const char *out_path, uint64_t *bytes)
         diag_path_error(out_path, "%s", strerror(errno));
         return -1;
     }
-    oct_writer_set_copy(w, atomic_file_copy_cb, af); /* the spooled records by the kernel */
     oct_err err = oct_writer_finish(w, atomic_file_stream(af), bytes);
     if (err != OCT_OK) {
         diag_path_error(out_path, "write: %s", err == OCT_EIO ? strerror(errno) : oct_strerror(err));

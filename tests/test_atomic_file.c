@@ -8,7 +8,6 @@
 #include <cmocka.h>
 
 #include <errno.h>
-#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -48,24 +47,19 @@ static unsigned char *slurp(const char *path, size_t *len)
 
 /* The caller's sequence (rasterize): atomic_file + oct_writer_finish +
  * commit; run in a child process, so that the fault hook's counters start at
- * zero. With `spool` (a directory), the records wait in files there and
- * reach the target by the kernel's copy (atomic_file_copy_cb), as
- * rasterize's do. Exit status: 0 success, 1 clean failure. */
-_Noreturn static void write_and_exit(const char *target, const test_tree *t, const char *fault,
-                                     const char *spool)
+ * zero. Exit status: 0 success, 1 clean failure. */
+_Noreturn static void write_and_exit(const char *target, const test_tree *t, const char *fault)
 {
     setenv("ATOMIC_FAULT", fault, 1);
     atomic_file *af = atomic_file_open(target);
     if (!af)
         _exit(1);
     oct_writer_params p = {.levels = t->levels, .edge = t->edge, .surface_count = t->surface_count,
-                           .palette = t->palette, .spool_dir = spool};
+                           .palette = t->palette};
     memcpy(p.origin, t->origin, sizeof p.origin);
     oct_writer *w;
     if (oct_writer_create(&p, &w) != OCT_OK)
         _exit(3);
-    if (spool)
-        oct_writer_set_copy(w, atomic_file_copy_cb, af);
     for (uint32_t d = 0; d < t->levels; d++)
         oct_writer_add_masks(w, d, t->masks[d], t->count[d]);
     oct_writer_add_voxels(w, t->voxels, t->surfaces, t->voxel_count);
@@ -86,32 +80,29 @@ _Noreturn static void write_and_exit(const char *target, const test_tree *t, con
     _exit(atomic_file_commit(af, &op) == 0 ? 0 : 1);
 }
 
-static int write_in_child(const char *target, const test_tree *t, const char *fault,
-                          const char *spool)
+static int write_in_child(const char *target, const test_tree *t, const char *fault)
 {
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0)
-        write_and_exit(target, t, fault, spool);
+        write_and_exit(target, t, fault);
     int status;
     assert_int_equal(waitpid(pid, &status, 0), pid);
     assert_true(WIFEXITED(status));
     return WEXITSTATUS(status);
 }
 
-/* Every write, fsync, close and rename failing in turn (once, and from
- * then on), with the records in memory and spooled (then copied by the
- * kernel, each copy a write for the hook): the target is the old file
- * until a run succeeds, then the new one, byte for byte what the stream
- * gives, and no temporary is left. */
-static void fault_loop(const char *dir, const char *spool)
+static void test_atomic_write_fault_loop(void **state)
 {
+    (void)state;
+    char dir[] = "/tmp/test_oct_af_XXXXXX";
+    assert_non_null(mkdtemp(dir));
     char target[600];
     snprintf(target, sizeof target, "%s/out.oct", dir);
     test_tree old, t;
     test_tree_random(&old, 3, 20, 1, 1, 0);
     test_tree_random(&t, 7, 3000, 2, 2, 1);
-    assert_int_equal(write_in_child(target, &old, "", spool), 0);
+    assert_int_equal(write_in_child(target, &old, ""), 0);
     size_t old_len;
     unsigned char *old_bytes = slurp(target, &old_len);
     static const char *ops[] = {"write", "fsync", "close", "rename"};
@@ -121,7 +112,7 @@ static void fault_loop(const char *dir, const char *spool)
             for (int n = 1;; n++) {
                 char spec[64];
                 snprintf(spec, sizeof spec, "%s:%d:%s%s", ops[o], n, errs[n % 2], sticky ? ":sticky" : "");
-                int rc = write_in_child(target, &t, spec, spool);
+                int rc = write_in_child(target, &t, spec);
                 assert_true(rc == 0 || rc == 1);
                 assert_int_equal(count_tmp_files(dir), 0);
                 if (rc == 0) {
@@ -136,86 +127,19 @@ static void fault_loop(const char *dir, const char *spool)
                 assert_true(n < 100);
             }
             /* Success replaced the target: put the old one back for the next op. */
-            assert_int_equal(write_in_child(target, &old, "", spool), 0);
+            assert_int_equal(write_in_child(target, &old, ""), 0);
         }
     }
     oct_file *f;
-    assert_int_equal(write_in_child(target, &t, "", spool), 0);
+    assert_int_equal(write_in_child(target, &t, ""), 0);
     assert_int_equal(oct_open(target, 0, &f, NULL), OCT_OK);
     oct_check_tree(f, &t);
     oct_close(f);
-    unsigned char *want, *got;
-    size_t want_len, got_len;
-    assert_int_equal(test_tree_write(&t, &want, &want_len), OCT_OK);
-    got = slurp(target, &got_len);
-    assert_int_equal(got_len, want_len);
-    assert_memory_equal(got, want, want_len);
-    free(want);
-    free(got);
     unlink(target);
+    rmdir(dir);
     free(old_bytes);
     test_tree_free(&old);
     test_tree_free(&t);
-}
-
-static void test_atomic_write_fault_loop(void **state)
-{
-    (void)state;
-    char dir[] = "/tmp/test_oct_af_XXXXXX";
-    assert_non_null(mkdtemp(dir));
-    fault_loop(dir, NULL);
-    fault_loop(dir, dir);
-    rmdir(dir);
-}
-
-/* atomic_file_copy_from: the bytes it copies land after what was written,
- * the caller writes the rest, and from a pipe (which the kernel's copy
- * refuses) it copies nothing and fails nothing. */
-static void test_copy_from(void **state)
-{
-    (void)state;
-    char dir[] = "/tmp/test_oct_cp_XXXXXX";
-    assert_non_null(mkdtemp(dir));
-    char src[600], target[600];
-    snprintf(src, sizeof src, "%s/src", dir);
-    snprintf(target, sizeof target, "%s/out", dir);
-    unsigned char bytes[70000];
-    for (size_t i = 0; i < sizeof bytes; i++)
-        bytes[i] = (unsigned char)(i * 131u + (i >> 9));
-    FILE *sf = fopen(src, "wb");
-    assert_non_null(sf);
-    assert_int_equal(fwrite(bytes, 1, sizeof bytes, sf), sizeof bytes);
-    assert_int_equal(fclose(sf), 0);
-    int in = open(src, O_RDONLY);
-    assert_true(in >= 0);
-    atomic_file *af = atomic_file_open(target);
-    assert_non_null(af);
-    assert_int_equal(atomic_file_write(af, "head", 4), 0); /* in the stream's buffer */
-    const uint64_t from = 1000, len = 60000;
-    const int64_t r = atomic_file_copy_from(af, in, from, len);
-    assert_true(r >= 0 && (uint64_t)r <= len);
-    print_message("copy_from: %lld of %llu bytes by the kernel\n", (long long)r,
-                  (unsigned long long)len);
-    assert_int_equal(atomic_file_write(af, bytes + from + r, (size_t)(len - (uint64_t)r)), 0);
-    int p[2];
-    assert_int_equal(pipe(p), 0);
-    assert_int_equal(write(p[1], "tail", 4), 4);
-    assert_int_equal(atomic_file_copy_from(af, p[0], 0, 4), 0);
-    assert_int_equal(atomic_file_write(af, "tail", 4), 0);
-    close(p[0]);
-    close(p[1]);
-    assert_int_equal(atomic_file_commit(af, NULL), 0);
-    close(in);
-    size_t l;
-    unsigned char *now = slurp(target, &l);
-    assert_int_equal(l, 4 + len + 4);
-    assert_memory_equal(now, "head", 4);
-    assert_memory_equal(now + 4, bytes + from, len);
-    assert_memory_equal(now + 4 + len, "tail", 4);
-    free(now);
-    unlink(src);
-    unlink(target);
-    rmdir(dir);
 }
 
 /* SIGTERM at random moments of a large atomic write: the target is the old
@@ -233,7 +157,7 @@ static void test_signal_during_write(void **state)
     unsigned char *nb;
     size_t nlen;
     assert_int_equal(test_tree_write(&t, &nb, &nlen), OCT_OK);
-    assert_int_equal(write_in_child(target, &old, "", NULL), 0);
+    assert_int_equal(write_in_child(target, &old, ""), 0);
     size_t old_len;
     unsigned char *old_bytes = slurp(target, &old_len);
     uint64_t rs = 99;
@@ -243,7 +167,7 @@ static void test_signal_during_write(void **state)
         assert_true(pid >= 0);
         if (pid == 0) {
             signal(SIGTERM, SIG_DFL);
-            write_and_exit(target, &t, "", run % 2 ? dir : NULL);
+            write_and_exit(target, &t, "");
         }
         usleep((useconds_t)(test_rand(&rs) % 30000));
         kill(pid, SIGTERM);
@@ -280,7 +204,6 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_atomic_write_fault_loop),
         cmocka_unit_test(test_signal_during_write),
-        cmocka_unit_test(test_copy_from),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

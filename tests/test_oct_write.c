@@ -357,7 +357,7 @@ static void assert_spool_holds(const oct_spool *s, const unsigned char *want, si
     char *mem = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&mem, &len);
-    oct_sink sink = {.f = f, .no_crc = 1};
+    oct_sink sink = {f, 0, 0, 1};
     assert_int_equal(oct_spool_put(s, &sink), 0);
     fclose(f);
     assert_int_equal(len, n);
