@@ -1,7 +1,6 @@
 /* Round trips through format/oct_write.c and format/oct_read.c: random,
- * empty, deepest and subtree files, in memory and through a file, a depth
- * over one chunk of the writer's store, the spec example, and the writer's
- * determinism. */
+ * empty, deepest and subtree files, in memory and through a file, the spec
+ * example, and the writer's determinism. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,7 +17,6 @@
 #include "format/oct.h"
 #include "format/oct_layout.h"
 #include "format/oct_normal.h"
-#include "format/oct_store.h"
 #include "tests/oct_check.h"
 
 static void test_round_trip_random_trees(void **state)
@@ -53,27 +51,6 @@ static void test_round_trip_random_trees(void **state)
             test_tree_free(&t);
         }
     }
-}
-
-/* A depth with more nodes than one chunk of the writer's store holds
- * (OCT_CHUNK masks): its node groups are read from both sides of a chunk
- * boundary, and every group's base and masks, and every voxel, read back as
- * written. */
-static void test_depth_over_one_chunk(void **state)
-{
-    (void)state;
-    test_tree t;
-    test_tree_random(&t, 9, 2600000, 1, 77, 0);
-    assert_true(t.count[8] > OCT_CHUNK + 8);
-    unsigned char *buf;
-    size_t len;
-    assert_int_equal(test_tree_write(&t, &buf, &len), OCT_OK);
-    oct_file *f = NULL;
-    assert_int_equal(oct_open_memory(buf, len, 0, &f, NULL), OCT_OK);
-    oct_check_tree(f, &t);
-    oct_close(f);
-    free(buf);
-    test_tree_free(&t);
 }
 
 static void test_round_trip_through_file(void **state)
@@ -326,7 +303,6 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_round_trip_random_trees),
         cmocka_unit_test(test_round_trip_through_file),
-        cmocka_unit_test(test_depth_over_one_chunk),
         cmocka_unit_test(test_empty_trees),
         cmocka_unit_test(test_deepest_tree),
         cmocka_unit_test(test_subtree_at_depth_40),

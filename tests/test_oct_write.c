@@ -18,7 +18,7 @@
 
 #include "format/oct.h"
 #include "format/oct_layout.h" /* oct__alloc_fail_after */
-#include "format/oct_store.h"  /* oct__spool_limit */
+#include "format/oct_store.h"  /* oct__spool_limit, OCT_CHUNK */
 #include "bench/oct_synth.h"
 #include "tests/oct_check.h"
 
@@ -266,25 +266,37 @@ static void test_allocation_failures(void **state)
     test_tree_free(&t);
 }
 
-/* A tree larger than the writer's storage chunks (2 MiB: 512 Ki voxel
- * records; from the second on, huge-page aligned): its arrays span several
- * chunks and the appends cross their boundaries, and the file read back
- * holds exactly the tree. */
+/* Trees larger than the writer's storage chunks (2 MiB: 512 Ki voxel
+ * records, or 2 Mi masks of one depth; from the second on, huge-page
+ * aligned): their arrays span several chunks and the appends cross their
+ * boundaries, the node groups are read from both sides of one, and the file
+ * read back holds exactly the tree. */
 static void test_large_tree_spans_chunks(void **state)
 {
     (void)state;
-    test_tree t;
-    test_tree_random(&t, 8, 2500000, 3, 99, 0);
-    assert_true(t.voxel_count * 4 > 4 * ((size_t)2 << 20));
-    unsigned char *out;
-    size_t len;
-    assert_int_equal(feed_writer(&t, 0, &out, &len), OCT_OK);
-    oct_file *f = NULL;
-    assert_int_equal(oct_open_memory(out, len, 0, &f, NULL), OCT_OK);
-    oct_check_tree(f, &t);
-    oct_close(f);
-    free(out);
-    test_tree_free(&t);
+    static const struct {
+        uint32_t levels, surfaces;
+        size_t target;
+        uint64_t seed;
+        int masks; /* 0: the records span chunks; 1: the deepest masks do */
+    } cases[] = {{8, 3, 2500000, 99, 0}, {9, 1, 2600000, 77, 1}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        test_tree t;
+        test_tree_random(&t, cases[c].levels, cases[c].target, cases[c].surfaces, cases[c].seed, 0);
+        if (cases[c].masks)
+            assert_true(t.count[t.levels - 1] > OCT_CHUNK + 8);
+        else
+            assert_true(t.voxel_count * 4 > 4 * ((size_t)2 << 20));
+        unsigned char *out;
+        size_t len;
+        assert_int_equal(feed_writer(&t, 0, &out, &len), OCT_OK);
+        oct_file *f = NULL;
+        assert_int_equal(oct_open_memory(out, len, 0, &f, NULL), OCT_OK);
+        oct_check_tree(f, &t);
+        oct_close(f);
+        free(out);
+        test_tree_free(&t);
+    }
 }
 
 /* Entries in directory d other than . and .. */
