@@ -45,141 +45,97 @@ static void line_point(const exact_line *l, double x, double p[3], double ep[3])
         ep[k] = tape_err_point(l->o[k], x, l->d[k], &p[k]);
 }
 
-int exact_fast_in_bound(const exact_bound *cb, const double p[3])
-{
-    return cb && p[0] >= cb->box[0].lo && p[0] <= cb->box[0].hi && p[1] >= cb->box[1].lo &&
-           p[1] <= cb->box[1].hi && p[2] >= cb->box[2].lo && p[2] <= cb->box[2].hi;
-}
-
-int exact_fast_bounded(exact_scratch *w, const exact_model *md, const double ep[3], double v,
-                       double d, tape_edir *e)
-{
-    const exact_bound *cb = md->cb;
-    if (!(fabs(v) <= 0x1p100 && fabs(d) <= 0x1p100))
-        return 0;
-    e->v = v;
-    e->d = d;
-    e->ev = (cb->e.ev + cb->e.grad[0] * ep[0] + cb->e.grad[1] * ep[1] + cb->e.grad[2] * ep[2]) * CM;
-    e->ed = (md->fd + md->hd[0] * ep[0] + md->hd[1] * ep[1] + md->hd[2] * ep[2]) * CM;
-    w->nbound++;
-    return 1;
-}
-
 /* g and g' at the computed point p of the line (within ep of the exact one,
  * which lies in the region's box) with bounds on their errors: with the
- * model's a-priori bound where p lies in its box too (exact_fast_in_bound,
- * exact_fast_bounded), else tape_eval_dir_err. With grad (may be NULL): f's
- * gradient at p from the same pass where the a-priori bound is used, else
- * grad[0] = NaN. 1, or 0: no bound. */
+ * model's a-priori bound where p lies in its box too (then the segment
+ * between them does, and f's gradient and g''s over the box carry the
+ * input error: |f(p) - f(P)| <= sum grad_k ep_k, |g'(p) - g'(P)| <= sum
+ * ep_k hd_k), else tape_eval_dir_err. With grad (may be NULL): f's gradient
+ * at p from the same pass where the a-priori bound is used, else grad[0] =
+ * NaN. 1, or 0: no bound. */
 static int eval_bounded(const tape *t, exact_scratch *w, const exact_line *l,
                         const exact_model *md, const double p[3], const double ep[3], tape_edir *e,
                         double grad[3])
 {
+    const exact_bound *cb = md->cb;
     if (grad)
         grad[0] = NAN;
-    if (exact_fast_in_bound(md->cb, p)) {
-        double v, d;
-        v = grad ? tape_eval_dir_grad(t, p, l->d, &d, grad, w->dirg) : tape_eval_dir(t, p, l->d, &d, w->dir);
-        return exact_fast_bounded(w, md, ep, v, d, e);
+    if (cb && p[0] >= cb->box[0].lo && p[0] <= cb->box[0].hi && p[1] >= cb->box[1].lo &&
+        p[1] <= cb->box[1].hi && p[2] >= cb->box[2].lo && p[2] <= cb->box[2].hi) {
+        e->v = grad ? tape_eval_dir_grad(t, p, l->d, &e->d, grad, w->dirg)
+                    : tape_eval_dir(t, p, l->d, &e->d, w->dir);
+        if (!(fabs(e->v) <= 0x1p100 && fabs(e->d) <= 0x1p100))
+            return 0;
+        e->ev = (cb->e.ev + cb->e.grad[0] * ep[0] + cb->e.grad[1] * ep[1] +
+                 cb->e.grad[2] * ep[2]) * CM;
+        e->ed = (md->fd + md->hd[0] * ep[0] + md->hd[1] * ep[1] + md->hd[2] * ep[2]) * CM;
+        w->nbound++;
+        return 1;
     }
     return tape_eval_dir_err(t, p, ep, l->d, e, w->edir);
 }
 
-void exact_place_begin(exact_place *pl, double a, double b, int sg, double K, double dmin,
-                       const exact_model *md)
-{
-    pl->md = md;
-    pl->K = K;
-    pl->dmin = dmin;
-    pl->sg = sg;
-    pl->it = 0;
-    pl->x = clamp(md->m - md->v / md->d, a, b); /* (NaN: a) */
-    pl->err = K * (pl->x - md->m) * (pl->x - md->m) / (2.0 * dmin);
-    pl->noise = 2.0 * md->ev / dmin;
-    pl->lo = a;
-    pl->hi = b;
-}
-
-int exact_place_ask(exact_place *pl, const exact_line *l)
-{
-    if (pl->it == 6)
-        return EXACT_PLACE_FAIL;
-    line_point(l, pl->x, pl->p, pl->ep);
-    const double K = pl->K;
-    return pl->it++ < 3 && K * pl->err * pl->err > pl->noise * pl->dmin ? EXACT_PLACE_PLAIN
-                                                                        : EXACT_PLACE_BOUNDED;
-}
-
-int exact_place_plain(exact_place *pl, double v, double dv)
-{
-    if (!(pl->sg > 0 ? dv > 0.0 : dv < 0.0) || v != v)
-        return EXACT_PLACE_FAIL; /* the double derivative disagrees with the certificate */
-    pl->x = clamp(pl->x - v / dv, pl->lo, pl->hi);
-    pl->err = pl->K * pl->err * pl->err / (2.0 * pl->dmin);
-    return EXACT_PLACE_MORE;
-}
-
-int exact_place_bounded(exact_place *pl, const tape_edir *e)
-{
-    const double K = pl->K, dmin = pl->dmin, x = pl->x;
-    const double rho = (fabs(e->v) + e->ev) / dmin * CM;
-    const double dr = (e->ed + K * rho) * CM;
-    if (!(pl->sg > 0 ? e->d > dr : e->d < -dr))
-        return EXACT_PLACE_FAIL;
-    unsigned f = 0;
-    const interval G = {interval_next_down(e->v - e->ev), interval_next_up(e->v + e->ev)};
-    const interval D = {interval_next_down(e->d - dr), interval_next_up(e->d + dr)};
-    const interval T = interval_sub((interval){x, x}, interval_div(G, D, &f), &f);
-    const double lo = T.lo > pl->lo ? T.lo : pl->lo;
-    const double hi = T.hi < pl->hi ? T.hi : pl->hi;
-    pl->lo = lo;
-    pl->hi = hi;
-    if (f || !(lo <= hi))
-        return EXACT_PLACE_FAIL; /* (cannot happen: both hold t*) */
-    pl->x = clamp(x - e->v / e->d, lo, hi);
-    const double ax = fabs(pl->x);
-    if (hi - lo <= EXACT_FAST_BAND(e->ev / fabs(e->d), interval_next_up(ax) - ax))
-        return EXACT_PLACE_DONE;
-    pl->err = hi - lo;
-    return EXACT_PLACE_MORE;
-}
-
 /* The root t* of g in [a, b], where g is certified monotone with g' of sign
- * sg and |g'| >= dmin there (exact_place_begin: Newton steps from the
- * model's estimate, plain while the next step's quadratic error would exceed
- * the model's noise, then with error bounds until the root's enclosure is
- * within EXACT_FAST_BAND), each evaluation made here; *root the Newton point
- * clamped into the enclosure, grad f at the last evaluation's point
- * (eval_bounded). 1, or 0: undecided. */
+ * sg and |g'| >= dmin there: Newton steps from the model's estimate, plain
+ * (tape_eval_dir) while the next step's quadratic error (K err^2 / 2 dmin,
+ * err the predicted error) would exceed the model's noise, then with error
+ * bounds (tape_eval_dir_err) at x: |x - t*| <= rho = (|v| + ev) / dmin, g'
+ * lies within dr = ed + K rho of d between x and t*, and t* - x = -g(x) /
+ * g'(xi) by the mean value theorem: t* lies in x - [v +- ev] / [d +- dr]
+ * (outward-rounded intervals), intersected with [a, b]. Accepted once that
+ * enclosure is no wider than EXACT_FAST_BAND; *root is the Newton point
+ * clamped into it, grad f at x from that evaluation (eval_bounded). 1, or 0:
+ * undecided. */
 static int place(const tape *t, exact_scratch *w, const exact_line *l, double a, double b,
                  int sg, double K, double dmin, const exact_model *md, double *root,
                  double grad[3])
 {
-    exact_place pl;
-    exact_place_begin(&pl, a, b, sg, K, dmin, md);
-    for (;;) {
-        int st = exact_place_ask(&pl, l);
-        if (st == EXACT_PLACE_PLAIN) {
+    double x = clamp(md->m - md->v / md->d, a, b); /* (NaN: a) */
+    double err = K * (x - md->m) * (x - md->m) / (2.0 * dmin);
+    const double noise = 2.0 * md->ev / dmin;
+    double lo = a, hi = b;
+    for (int it = 0; it < 6; it++) {
+        double p[3], ep[3];
+        line_point(l, x, p, ep);
+        if (it < 3 && K * err * err > noise * dmin) {
             double dv;
-            const double v = tape_eval_dir(t, pl.p, l->d, &dv, w->dir);
-            st = exact_place_plain(&pl, v, dv);
-        } else if (st == EXACT_PLACE_BOUNDED) {
-            tape_edir e;
-            st = eval_bounded(t, w, l, md, pl.p, pl.ep, &e, grad) ? exact_place_bounded(&pl, &e)
-                                                                   : EXACT_PLACE_FAIL;
+            const double v = tape_eval_dir(t, p, l->d, &dv, w->dir);
+            if (!(sg > 0 ? dv > 0.0 : dv < 0.0) || v != v)
+                return 0; /* the double derivative disagrees with the certificate */
+            x = clamp(x - v / dv, lo, hi);
+            err = K * err * err / (2.0 * dmin);
+            continue;
         }
-        if (st == EXACT_PLACE_FAIL)
+        tape_edir e;
+        if (!eval_bounded(t, w, l, md, p, ep, &e, grad))
             return 0;
-        if (st == EXACT_PLACE_DONE) {
-            *root = pl.x;
+        const double rho = (fabs(e.v) + e.ev) / dmin * CM;
+        const double dr = (e.ed + K * rho) * CM;
+        if (!(sg > 0 ? e.d > dr : e.d < -dr))
+            return 0;
+        unsigned f = 0;
+        const interval G = {interval_next_down(e.v - e.ev), interval_next_up(e.v + e.ev)};
+        const interval D = {interval_next_down(e.d - dr), interval_next_up(e.d + dr)};
+        const interval T = interval_sub((interval){x, x}, interval_div(G, D, &f), &f);
+        lo = T.lo > lo ? T.lo : lo;
+        hi = T.hi < hi ? T.hi : hi;
+        if (f || !(lo <= hi))
+            return 0; /* (cannot happen: both hold t*) */
+        x = clamp(x - e.v / e.d, lo, hi);
+        const double ax = fabs(x);
+        if (hi - lo <= EXACT_FAST_BAND(e.ev / fabs(e.d), interval_next_up(ax) - ax)) {
+            *root = x;
             return 1;
         }
+        err = hi - lo;
     }
+    return 0;
 }
 
-void exact_fast_model_begin(const exact_line *l, double m, const exact_bound *cb,
-                            exact_model *model, double p[3], double ep[3])
+int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
+                     const exact_bound *cb, exact_model *model)
 {
+    double p[3], ep[3];
     line_point(l, m, p, ep);
     model->m = m;
     model->cb = cb;
@@ -193,29 +149,17 @@ void exact_fast_model_begin(const exact_line *l, double m, const exact_bound *cb
         model->hd[1] = (M[TAPE_HXY] * ax + M[TAPE_HYY] * ay + M[TAPE_HYZ] * az) * CM;
         model->hd[2] = (M[TAPE_HXZ] * ax + M[TAPE_HYZ] * ay + M[TAPE_HZZ] * az) * CM;
     }
-}
-
-void exact_fast_model_end(exact_model *model, const tape_edir *e)
-{
-    model->v = e->v;
-    model->d = e->d;
-    model->ev = e->ev;
-    model->ed = e->ed;
-}
-
-int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
-                     const exact_bound *cb, exact_model *model)
-{
-    double p[3], ep[3];
-    exact_fast_model_begin(l, m, cb, model, p, ep);
     tape_edir e;
     if (!eval_bounded(t, w, l, model, p, ep, &e, NULL))
         return 0;
-    exact_fast_model_end(model, &e);
+    model->v = e.v;
+    model->d = e.d;
+    model->ev = e.ev;
+    model->ed = e.ed;
     return 1;
 }
 
-#define ONE_ROOT EXACT_FAST_ONE_ROOT
+#define ONE_ROOT 3 /* (classify: one root, to be placed) */
 
 /* The Taylor decisions of exact_fast_decide without the placing: NONE,
  * UNDECIDED, or ONE_ROOT with g''s sign *sg and |g'| >= *dmin on [a, b]. */
@@ -254,12 +198,6 @@ int exact_fast_decide(const tape *t, exact_scratch *w, const exact_line *l, doub
         return st;
     return place(t, w, l, a, b, sg, curv, dmin, model, root, grad) ? EXACT_FAST_ROOT
                                                              : EXACT_FAST_UNDECIDED;
-}
-
-int exact_fast_classify(const exact_model *model, double a, double b, double curv, int *sg,
-                        double *dmin)
-{
-    return classify(model, a, b, curv, sg, dmin);
 }
 
 /* Could a per-point model at the same m decide where this one did not?

@@ -51,46 +51,6 @@ typedef struct exact_model {
 int exact_fast_model(const tape *t, exact_scratch *w, const exact_line *l, double m,
                      const exact_bound *cb, exact_model *model);
 
-/* exact_fast_model and exact_fast_decide in steps, for a caller that makes
- * the evaluations itself (several rays' at once: exact_batch.h), each step
- * the same operations as theirs, so the same results:
- * - exact_fast_model_begin: the model's point p (within ep of the exact
- *   one) and its per-line bounds; with cb, an evaluation at p is bounded by
- *   it where exact_fast_in_bound(cb, p): tape_eval_dir's v and d there
- *   through exact_fast_bounded (0: not finite, no model), then
- *   exact_fast_model_end;
- * - exact_fast_classify: the Taylor decisions of exact_fast_decide,
- *   EXACT_FAST_NONE, EXACT_FAST_UNDECIDED, or EXACT_FAST_ONE_ROOT with g''s
- *   sign and |g'| >= dmin on [a, b], then the placing: exact_place_begin,
- *   and while exact_place_ask asks (the point in pl->p, within pl->ep), a
- *   plain evaluation (tape_eval_dir: exact_place_plain) or one bounded as
- *   the model's (tape_eval_dir_grad, exact_fast_bounded:
- *   exact_place_bounded), until EXACT_PLACE_DONE (the root in pl->x, the
- *   gradient the last bounded evaluation's) or EXACT_PLACE_FAIL (undecided). */
-#define EXACT_FAST_ONE_ROOT 3
-void exact_fast_model_begin(const exact_line *l, double m, const exact_bound *cb,
-                            exact_model *model, double p[3], double ep[3]);
-void exact_fast_model_end(exact_model *model, const tape_edir *e);
-int exact_fast_in_bound(const exact_bound *cb, const double p[3]);
-int exact_fast_bounded(exact_scratch *w, const exact_model *md, const double ep[3], double v,
-                       double d, tape_edir *e);
-int exact_fast_classify(const exact_model *model, double a, double b, double curv, int *sg,
-                        double *dmin);
-
-enum { EXACT_PLACE_FAIL, EXACT_PLACE_DONE, EXACT_PLACE_MORE, EXACT_PLACE_PLAIN,
-       EXACT_PLACE_BOUNDED };
-typedef struct exact_place {
-    const exact_model *md;
-    double K, dmin, noise, x, err, lo, hi;
-    double p[3], ep[3]; /* the point asked about */
-    int sg, it;
-} exact_place;
-void exact_place_begin(exact_place *pl, double a, double b, int sg, double K, double dmin,
-                       const exact_model *md);
-int exact_place_ask(exact_place *pl, const exact_line *l);
-int exact_place_plain(exact_place *pl, double v, double dv);
-int exact_place_bounded(exact_place *pl, const tape_edir *e);
-
 /* The first root of g(t) = f(o + t d) on [a, b] (a <= b, finite) decided
  * by Taylor's theorem from the model (at any m whose point lies in a box,
  * convex, holding the segment's points, over which `curv` bounds |g''|):
