@@ -46,7 +46,7 @@ D=$(dirname "$0")
 . "$D/lib.sh"
 for t in "$BIN/rasterize" "$BIN/render" "$TOOLS/refcast" "$TOOLS/imgcompare" "$TOOLS/gradmax" \
          "$TOOLS/scene2pov" "$TOOLS/shellratio" "$TOOLS/normalerr"; do
-    [ -x "$t" ] || { echo "bench: $t missing: run 'make all tools' first" >&2; exit 1; }
+    [ -x "$t" ] || { echo "bench: $t missing: run 'make pgo tools' (or 'make all tools') first" >&2; exit 1; }
 done
 sh "$D/deps.sh" "$MODE"
 have() { command -v "$1" >/dev/null 2>&1; }
