@@ -153,9 +153,9 @@ programs: $(PROGRAMS)
 
 # bin/rasterize and bin/render built with profile feedback (GCC): the
 # programs instrumented (-fprofile-generate) in $(PGO_B), run on
-# bench/pgo_train.sh's workload, compiled again from the same objects'
-# places with the counts that left (-fprofile-use; code the training never
-# ran is compiled as without a profile), then checked: they must write the
+# bench/pgo_train.sh's workload, compiled again in the same places with the
+# counts the training left (-fprofile-use; code the training never ran is
+# compiled as without a profile), then checked: they must write the
 # training's files again, byte for byte. Rasterizing takes 0-17 % less time
 # by scene (docs/perf-log.md); the benchmark runs these.
 pgo: deps
