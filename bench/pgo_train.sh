@@ -27,6 +27,7 @@ run() {
     eval "$cmd" || { echo "pgo: $name failed: $cmd" >&2; exit 1; }
     if [ $check = 1 ]; then
         for f in "$W/$name".*; do
+            [ -e "$f" ] || { echo "pgo: $name: no training output in $W (train first)" >&2; exit 1; }
             cmp -s "$f" "$W/check.${f##*/"$name".}" ||
                 { echo "pgo: $name: ${f##*/} differs from the instrumented build's" >&2; exit 1; }
         done
@@ -48,9 +49,8 @@ for s in blobs_a blobs_b csg gyroid manyblobs; do
     run "r9.$s" "$BIN/rasterize scenes/$s.scene -o @OUT@.oct --levels 9 -q"
     run "s9.$s" "$BIN/rasterize scenes/$s.scene -o @OUT@.oct --levels 9 -q --shell-only"
 done
-for s in blobs_a csg gyroid; do
+for s in blobs_a csg gyroid; do # (their r9 files come from the loop above)
     [ $check = 1 ] && [ $s != gyroid ] && continue
-    [ -f "$W/r9.$s.oct" ] || run "r9.$s" "$BIN/rasterize scenes/$s.scene -o @OUT@.oct --levels 9 -q"
     run "v9.$s" "$BIN/render $W/r9.$s.oct -o @OUT@.png --size 512x512 -q" \
         "&& $BIN/render $W/r9.$s.oct -o @OUT@.e.png --size 512x512 --exact -q"
 done
