@@ -183,10 +183,15 @@ if has rastspeed; then
         END { if (n) print "." }' "$RES/rastspeed.csv"
     own_run rastspeed
     echo
-    echo "| scene | levels | seconds | voxels | M voxels/s (≥ 10) | CPU % | --shell-only s | M voxels/s (≥ 25) | CPU % |"
-    echo "|---|---|---|---|---|---|---|---|---|"
-    awk -F, "$AWKLIB"'NR > 1 { printf "| %s | %d | %.2f | %d | %.2f%s | %s | %s | %s%s | %s |\n", $6, $7, $8, $9, $10,
-        mark($10 >= 10), $11, num("%.2f", $12), num("%.2f", $13), ($13 == "" ? "" : mark($13 >= 25)), num("%s", $14) }' \
+    echo "The portable columns time the same runs with \`DDA_SIMD=portable\` (the lane evaluators'"
+    echo "build without AVX2), whose files must be the same bytes (same: ✓)."
+    echo
+    echo "| scene | levels | seconds | voxels | M voxels/s (≥ 10) | CPU % | --shell-only s | M voxels/s (≥ 25) | CPU % | portable M voxels/s | portable --shell-only | same |"
+    echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+    awk -F, "$AWKLIB"'NR > 1 { printf "| %s | %d | %.2f | %d | %.2f%s | %s | %s | %s%s | %s | %s%s | %s%s | %s |\n", $6, $7, $8, $9, $10,
+        mark($10 >= 10), $11, num("%.2f", $12), num("%.2f", $13), ($13 == "" ? "" : mark($13 >= 25)), num("%s", $14),
+        num("%.2f", $15), ($15 == "" ? "" : mark($15 >= 10)), num("%.2f", $16), ($16 == "" ? "" : mark($16 >= 25)),
+        ($17 == "" ? "-" : substr(mark($17 == 1), 2)) }' \
         "$RES/rastspeed.csv"
 fi
 if has shell; then

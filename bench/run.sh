@@ -187,24 +187,26 @@ fi
 
 # ---- rasterize speed: M voxels kept a second and CPU use (user + system over
 # wall, 200 % = both cores busy to the end), the median of SPEED_REPS runs, full records and
-# --shell-only; the shell: voxels kept over the voxels the surface really
-# passes through (bench/shellratio), and the records' errors (bench/normalerr) ----
-speed_run() { # SCENE LEVELS OUT [FLAGS]: prints "seconds voxels mvox_s cpu_pct"
+# --shell-only, each on both paths of the lane evaluators' dispatch (the AVX2
+# build where the processor has it, and DDA_SIMD=portable); the shell: voxels
+# kept over the voxels the surface really passes through (bench/shellratio),
+# and the records' errors (bench/normalerr) ----
+speed_run() { # SCENE LEVELS OUT [FLAGS]: prints "seconds voxels mvox_s cpu_pct"; $SIMD: the path
     s=$1 L=$2 o=$3; shift 3
+    set -- env ${SIMD:+DDA_SIMD=$SIMD} "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@"
     if [ -x /usr/bin/time ]; then
         # the run of median wall time among SPEED_REPS (a shared machine's load comes and goes)
         : >"$WORK/st"
         r=0
         while [ $r -lt "$SPEED_REPS" ]; do
-            /usr/bin/time -f "time %e %U %S" "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" \
-                >"$WORK/rlog" 2>&1
+            /usr/bin/time -f "time %e %U %S" "$@" >"$WORK/rlog" 2>&1
             sed -n 's/^time \([0-9.]*\) \([0-9.]*\) \([0-9.]*\)$/\1 \2 \3/p' "$WORK/rlog" >>"$WORK/st"
             r=$((r + 1))
         done
         set -- $(sort -g "$WORK/st" | sed -n "$(((SPEED_REPS + 1) / 2))p")
         sec=$1 cpu=$(awk -v w="$1" -v u="$2" -v k="$3" 'BEGIN { printf "%.0f", (w > 0 ? 100 * (u + k) / w : 0) }')
     else
-        "$BIN/rasterize" "scenes/$s.scene" -o "$o" --levels "$L" "$@" >"$WORK/rlog" 2>&1
+        "$@" >"$WORK/rlog" 2>&1
         sec=$(sed -n 's/.*; \([0-9.]*\) s, peak memory.*/\1/p' "$WORK/rlog") cpu=nan
     fi
     v=$(sed -n 's/.* \([0-9]*\) voxels, [0-9]* nodes.*/\1/p' "$WORK/rlog")
@@ -212,17 +214,28 @@ speed_run() { # SCENE LEVELS OUT [FLAGS]: prints "seconds voxels mvox_s cpu_pct"
 }
 if want speed; then
     SPEED="$RES/rastspeed.csv" SHELL="$RES/shell.csv"
-    echo "$PROVH,scene,levels,seconds,voxels,mvox_s,cpu_pct,shell_only_seconds,shell_only_mvox_s,shell_only_cpu_pct" >"$SPEED"
+    echo "$PROVH,scene,levels,seconds,voxels,mvox_s,cpu_pct,shell_only_seconds,shell_only_mvox_s,shell_only_cpu_pct,portable_mvox_s,portable_shell_only_mvox_s,portable_same" >"$SPEED"
     echo "$PROVH,scene,levels,kept,real,ratio,lost,voxels_near,voxels_missed,normal_mean_deg,normal_p99_deg,normal_max_deg,offset_mean_vox,offset_p99_vox,offset_max_vox" >"$SHELL"
     for s in $SPEED_SCENES; do
         for L in $SPEED_LEVELS; do
+            SIMD=
             set -- $(speed_run "$s" "$L" "$WORK/speed.oct")
-            rm -f "$WORK/speed.oct"
             sec=$1 v=$2 mv=$3 cpu=$4
             # the level sweep uses this file again rather than rasterize it twice
             set -- $(speed_run "$s" "$L" "$WORK/shell.$s.$L.oct" --shell-only)
-            echo "$PROV,$s,$L,$sec,$v,$mv,$cpu,$1,$3,$4" >>"$SPEED"
-            echo "  rasterize speed $s levels $L: $sec s, $v voxels, $mv M voxels/s, CPU $cpu %; --shell-only $1 s, $3 M voxels/s, CPU $4 %"
+            ssec=$1 smv=$3 scpu=$4
+            # the portable path: its speed, and its files the same bytes
+            SIMD=portable
+            set -- $(speed_run "$s" "$L" "$WORK/speed.p.oct")
+            pmv=$3
+            set -- $(speed_run "$s" "$L" "$WORK/shell.p.oct" --shell-only)
+            psmv=$3 SIMD=
+            same=1
+            cmp -s "$WORK/speed.oct" "$WORK/speed.p.oct" && cmp -s "$WORK/shell.$s.$L.oct" "$WORK/shell.p.oct" ||
+                { same=0; echo "bench: $s levels $L: the portable path wrote other bytes" >&2; }
+            rm -f "$WORK/speed.oct" "$WORK/speed.p.oct" "$WORK/shell.p.oct"
+            echo "$PROV,$s,$L,$sec,$v,$mv,$cpu,$ssec,$smv,$scpu,$pmv,$psmv,$same" >>"$SPEED"
+            echo "  rasterize speed $s levels $L: $sec s, $v voxels, $mv M voxels/s, CPU $cpu %; --shell-only $ssec s, $smv M voxels/s, CPU $scpu %; portable path $pmv / $psmv M voxels/s, same bytes: $same"
         done
         for L in $SHELL_LEVELS; do
             o="$WORK/shell.oct"

@@ -15,8 +15,9 @@ $P,blobs_a,10,1024,shadows,71.9,1.50,0,25.57,14.1,,14.1
 $P,blobs_a,10,1024,all,402.9,10.28,0.2,2.5,,,7.06
 CSV
 cat >"$R/rastspeed.csv" <<CSV
-$H,scene,levels,seconds,voxels,mvox_s,cpu_pct,shell_only_seconds,shell_only_mvox_s,shell_only_cpu_pct
-$P,gyroid,12,95.5,1000000000,10.47,190,30.1,33.2,195
+$H,scene,levels,seconds,voxels,mvox_s,cpu_pct,shell_only_seconds,shell_only_mvox_s,shell_only_cpu_pct,portable_mvox_s,portable_shell_only_mvox_s,portable_same
+$P,gyroid,12,95.5,1000000000,10.47,190,30.1,33.2,195,9.8,26.1,1
+$P,blobs_a,10,0.2,2792804,13.96,190,0.12,23.27,188,10.2,24.5,0
 $P,csg,10,0.53,4446496,8.39,189,,,
 CSV
 cat >"$R/shell.csv" <<CSV
@@ -65,8 +66,9 @@ has "| one ray a pixel | 10 | 1024² | 39.2 | 1.00 | 0.00 | 26.96 | - | - |"
 has "| --aa 4 | 10 | 1024² | 81.8 | 2.09 ✗ (≤ 1.6) | 0.17 | 13.33 | - | - |"
 has "| --shadows | 10 | 1024² | 71.9 | 1.50 ✓ (≤ 1.6) | 0.00 | 25.57 | 14.10 ✓ | - |"
 has "| --aa 4 --shadows --ao 16 --exact | 10 | 1024² | 402.9 | 10.28 | 0.20 | 2.50 | - | - (shadow + AO: 7.06) |"
-has "| gyroid | 12 | 95.50 | 1000000000 | 10.47 ✓ | 190 | 30.10 | 33.20 ✓ | 195 |"
-has "| csg | 10 | 0.53 | 4446496 | 8.39 ✗ | 189 | - | - | - |"
+has "| gyroid | 12 | 95.50 | 1000000000 | 10.47 ✓ | 190 | 30.10 | 33.20 ✓ | 195 | 9.80 ✗ | 26.10 ✓ | ✓ |"
+has "| blobs_a | 10 | 0.20 | 2792804 | 13.96 ✓ | 190 | 0.12 | 23.27 ✗ | 188 | 10.20 ✓ | 24.50 ✗ | ✗ |"
+has "| csg | 10 | 0.53 | 4446496 | 8.39 ✗ | 189 | - | - | - | - | - | - |"
 has "Runs over a minute: gyroid levels 12 96 s."
 # a table from another run than the header's names its own; the others do not
 has "These rows: cpu (2 cores), 2026-12-05T10:00Z, commit def5678."
