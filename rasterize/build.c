@@ -166,6 +166,13 @@ static int centre_rounding_bounds(build_ctx *c)
     return ok ? 0 : -1;
 }
 
+unsigned build_mean_value_levels(const scene *sc, build_method method)
+{
+    if (method != BUILD_INTERVAL || sc->nsurfaces != 1 || tape_has_kink(&sc->surfaces[0].tape))
+        return 3;
+    return 5;
+}
+
 int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p)
 {
     memset(c, 0, sizeof *c);
@@ -175,6 +182,7 @@ int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p)
     c->levels = p->levels;
     c->nsurf = (unsigned)sc->nsurfaces;
     c->task_depth = p->levels - 1 < TASK_DEPTH ? p->levels - 1 : TASK_DEPTH;
+    c->mv_levels = build_mean_value_levels(sc, p->method);
     build_cube(sc, c->origin, &c->edge);
     for (int k = 0; k < 3; k++)
         c->bmax[k] = sc->hi[k];

@@ -49,6 +49,13 @@ typedef struct build_stats {
     uint64_t normal_fallbacks;   /* voxels whose gradient was zero or not finite */
 } build_stats;
 
+/* How many of the finest levels the mean-value form tests (subdivide.c;
+ * at least 2): 5 for one surface with no kink (abs, min, max) under the
+ * interval method, whose tape the coarse levels' pruning barely shortens and
+ * the form tests more tightly than the plain test, else 3, below the levels
+ * where pruning decides kinks. A shard's partition lies above them. */
+unsigned build_mean_value_levels(const scene *sc, build_method method);
+
 /* The cube the grid covers: min corner of `bounds`, edge = its longest side. */
 void build_cube(const scene *sc, double origin[3], double *edge);
 

@@ -74,6 +74,7 @@ typedef struct build_ctx {
     const scene *sc;
     const build_params *par;
     unsigned levels, nsurf, task_depth;
+    unsigned mv_levels;        /* build_mean_value_levels */
     double origin[3], edge;
     double cell_edge[OCT_MAX_LEVELS + 1]; /* edge / 2^depth, exact (a power-of-two scaling) */
     double bmax[3];            /* bounds' max corner: cells are clipped to it */

@@ -28,12 +28,12 @@ int shard_parse(const char *s, uint32_t *index, uint32_t *count)
     return 0;
 }
 
-unsigned shard_depth(unsigned levels, uint32_t count)
+unsigned shard_depth(unsigned levels, unsigned mv_levels, uint32_t count)
 {
     unsigned k = SHARD_MIN_DEPTH;
     while ((UINT64_C(1) << (3 * k)) < 64 * (uint64_t)count)
         k++;
-    unsigned top = levels > 3 ? levels - 3 : 0;
+    unsigned top = levels > mv_levels ? levels - mv_levels : 0;
     return k < top ? k : top;
 }
 
@@ -134,7 +134,7 @@ uint32_t shard_partition_crc(const uint64_t *bounds, uint32_t count)
 int shard_plan(const scene *sc, const build_params *p, uint32_t index, uint32_t count,
                build_shard *out, double *share)
 {
-    unsigned k = shard_depth(p->levels, count);
+    unsigned k = shard_depth(p->levels, build_mean_value_levels(sc, p->method), count);
     uint64_t ncells = UINT64_C(1) << (3 * k);
     uint64_t *weight = malloc(ncells * sizeof *weight);
     uint64_t *bounds = malloc(((size_t)count + 1) * sizeof *bounds);

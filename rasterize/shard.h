@@ -18,9 +18,10 @@
 int shard_parse(const char *s, uint32_t *index, uint32_t *count);
 
 /* The depth k of the partition of an N-way split at `levels`: the least k
- * with 8^k >= 64 N, at least 4, and at most levels - 3 (where the
- * subdivision still tests cells one by one) and at least 0. */
-unsigned shard_depth(unsigned levels, uint32_t count);
+ * with 8^k >= 64 N, at least 4, and at most levels - mv_levels (the
+ * scene's build_mean_value_levels: above them the subdivision still tests
+ * cells one by one) and at least 0. */
+unsigned shard_depth(unsigned levels, unsigned mv_levels, uint32_t count);
 
 /* The work estimate of each cell of depth k (8^k values, Morton order):
  * 0 for a cell no surface may cross, else 1 + the number of its

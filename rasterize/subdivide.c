@@ -1,20 +1,19 @@
 /* subdivide: the recursion. A task's cell is subdivided depth-first,
  * children in slot order, so every depth's nodes come out in Morton order.
- * Above the finest MEAN_VALUE_LEVELS a child is tested with its parent's
- * pruned tapes by the plain interval test (cell_test_surviving; with one
- * surface the eight together, children_may_cross); there and below, all
- * eight at once with the mean-value form (child_enclosures); a
- * leaf-parent's voxels then take the re-tests of voxel_retest.c. */
+ * Above the finest c->mv_levels levels (build_mean_value_levels) a child is
+ * tested with its parent's pruned tapes by the plain interval test
+ * (cell_test_surviving; with one surface the eight together,
+ * children_may_cross); there and below, all eight at once with the
+ * mean-value form (child_enclosures); a leaf-parent's voxels then take the
+ * re-tests of voxel_retest.c. */
 #include "rasterize/build_internal.h"
 #include "rasterize/cell_geometry.h"
 #include "rasterize/voxel_retest.h"
 
-#define MEAN_VALUE_LEVELS 3   /* the finest levels whose cells the mean-value form tests */
-_Static_assert(MEAN_VALUE_LEVELS >= 2, "leaf-parents reuse their parent's gradient enclosure");
 /* Cells of depth below this (larger than 1/256 of the cube) are too big for
  * a gradient enclosure to be tight: there the plain interval test runs too,
- * and either may drop the cell. From levels 10 up the mean-value levels are
- * all this deep, so the cost is paid on coarse grids only. */
+ * and either may drop the cell. From levels 11 (13 for a scene with five
+ * mean-value levels) the mean-value levels are all this deep. */
 #define MEAN_VALUE_ALONE_DEPTH 8
 
 static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
@@ -294,12 +293,12 @@ static uint8_t visit_mean_value(worker *wk, unsigned depth, const uint64_t cell[
     cell_box(c, depth, cell, pbox, pc);
     /* The first mean-value node of its task's subtree: the records below
      * it evaluate the tapes made for its box. */
-    if ((depth == c->task_depth || depth + MEAN_VALUE_LEVELS == c->levels) &&
+    if ((depth == c->task_depth || depth + c->mv_levels == c->levels) &&
         !(c->par->shell_only && ns == 1))
         record_tapes(wk, pidx, pbox);
     /* A leaf-parent reuses its parent's gradient enclosure: the parent's box
      * holds its own, one evaluation fewer for a slightly wider form. */
-    int reuse = depth + 1 == c->levels; /* its parent ran here too: MEAN_VALUE_LEVELS >= 2 */
+    int reuse = depth + 1 == c->levels; /* its parent ran here too: mv_levels >= 2 */
     for (unsigned k = 0; k < wk->nact[pidx]; k++) {
         unsigned s = wk->act[(size_t)pidx * ns + k];
         interval *G = &wk->grad[((size_t)pidx * ns + s) * 3];
@@ -384,7 +383,7 @@ static uint8_t visit_coarse(worker *wk, unsigned depth, const uint64_t cell[3])
         want |= (uint8_t)(shard_meets(c, depth + 1, cc.cell[i]) << i); /* this shard's piece */
     }
     const uint8_t live = children_may_cross(wk, depth, want, &cc);
-    if (depth + 1 + MEAN_VALUE_LEVELS != c->levels) {
+    if (depth + 1 + c->mv_levels != c->levels) {
         for (unsigned m = live; m && !wk->failed; m &= m - 1) {
             const unsigned i = (unsigned)__builtin_ctz(m);
             child_take(wk, depth, &cc, i);
@@ -418,7 +417,7 @@ static uint8_t visit_node(worker *wk, unsigned depth, const uint64_t cell[3],
 {
     const build_ctx *c = wk->c;
     uint8_t mask = 0;
-    if (depth + MEAN_VALUE_LEVELS >= c->levels && c->par->method == BUILD_INTERVAL) {
+    if (depth + c->mv_levels >= c->levels && c->par->method == BUILD_INTERVAL) {
         mask = visit_mean_value(wk, depth, cell, given);
     } else if (c->nsurf == 1 && c->par->method == BUILD_INTERVAL && depth + 1 < c->levels &&
                wk->coarse_slots) {

@@ -200,7 +200,8 @@ static void test_merge_scenes(void **state)
     check_merge("scenes/gyroid.scene", 6, 64);
     with_function = 0;
     check_merge("scenes/csg.scene", 8, 3);
-    check_merge("scenes/torus.scene", 4, 5);  /* partition depth 1 */
+    check_merge("scenes/torus.scene", 6, 5);  /* partition depth 1 (five mean-value levels) */
+    check_merge("scenes/csg.scene", 4, 5);    /* partition depth 1 (three) */
     check_merge("scenes/sphere.scene", 3, 2); /* depth 0: one shard holds everything */
     check_merge("scenes/sphere.scene", 1, 2);
 }
@@ -242,16 +243,19 @@ static void test_merge_refuses(void **state)
     with_function = 1;
     scene *a = test_scene_load("scenes/blobs_a.scene"), *b = test_scene_load("scenes/blobs_b.scene");
     split s3, s2, t3, l3;
-    make_split(a, 7, 3, "a", &s3);
-    make_split(a, 7, 2, "a", &s2);
-    make_split(b, 7, 3, "b", &t3);
+    /* levels 9: the partition of depth 4 (above the five mean-value levels
+     * of these smooth scenes) leaves the last cell empty, as the gapped
+     * shard below needs */
+    make_split(a, 9, 3, "a", &s3);
+    make_split(a, 9, 2, "a", &s2);
+    make_split(b, 9, 3, "b", &t3);
     make_split(a, 6, 3, "l", &l3);
     char whole[256], cut[256], flip[256], missing[256];
-    snprintf(whole, sizeof whole, "%s/whole7.oct", dir);
+    snprintf(whole, sizeof whole, "%s/whole9.oct", dir);
     snprintf(cut, sizeof cut, "%s/cut.oct", dir);
     snprintf(flip, sizeof flip, "%s/flip.oct", dir);
     snprintf(missing, sizeof missing, "%s/no-such.oct", dir);
-    rasterize_to(a, 7, 2, 0, 0, whole);
+    rasterize_to(a, 9, 2, 0, 0, whole);
 
     expect_fail(NULL, 0, OCT_EUSAGE, NULL, "no parts");
     const char *one[] = {s3.path[1]};

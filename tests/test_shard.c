@@ -43,15 +43,39 @@ static void test_parse(void **state)
 static void test_depth(void **state)
 {
     (void)state;
-    assert_int_equal(shard_depth(12, 1), 4);
-    assert_int_equal(shard_depth(12, 64), 4);   /* 8^4 = 4096 = 64 * 64 */
-    assert_int_equal(shard_depth(12, 65), 5);
-    assert_int_equal(shard_depth(12, 4096), 6);
-    assert_int_equal(shard_depth(7, 64), 4);    /* levels - 3 */
-    assert_int_equal(shard_depth(6, 64), 3);
-    assert_int_equal(shard_depth(3, 2), 0);
-    assert_int_equal(shard_depth(1, 2), 0);
-    assert_int_equal(shard_depth(20, 4096), 6);
+    assert_int_equal(shard_depth(12, 3, 1), 4);
+    assert_int_equal(shard_depth(12, 3, 64), 4);   /* 8^4 = 4096 = 64 * 64 */
+    assert_int_equal(shard_depth(12, 3, 65), 5);
+    assert_int_equal(shard_depth(12, 3, 4096), 6);
+    assert_int_equal(shard_depth(7, 3, 64), 4);    /* levels - 3 */
+    assert_int_equal(shard_depth(6, 3, 64), 3);
+    assert_int_equal(shard_depth(3, 3, 2), 0);
+    assert_int_equal(shard_depth(1, 3, 2), 0);
+    assert_int_equal(shard_depth(20, 3, 4096), 6);
+    /* five mean-value levels (a smooth scene): the partition stays above them */
+    assert_int_equal(shard_depth(12, 5, 4096), 6);
+    assert_int_equal(shard_depth(10, 5, 4096), 5);
+    assert_int_equal(shard_depth(7, 5, 64), 2);
+    assert_int_equal(shard_depth(5, 5, 2), 0);
+}
+
+/* Five mean-value levels for one kink-free surface under the interval
+ * method, three otherwise. */
+static void test_mean_value_levels(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *path;
+        unsigned want;
+    } cases[] = {{"scenes/blobs_a.scene", 5}, {"scenes/sphere.scene", 5},
+                 {"scenes/csg.scene", 3},     {"scenes/gyroid.scene", 3},
+                 {"scenes/multi.scene", 3}};
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        scene *sc = test_scene_load(cases[i].path);
+        assert_int_equal(build_mean_value_levels(sc, BUILD_INTERVAL), cases[i].want);
+        assert_int_equal(build_mean_value_levels(sc, BUILD_LIPSCHITZ), 3);
+        scene_free(sc);
+    }
 }
 
 static void test_cut(void **state)
@@ -176,7 +200,7 @@ static void check_union(const char *path, unsigned levels, uint32_t count, unsig
         build_part(sc, levels, threads, i, count, &v, &sh);
         assert_int_equal(sh.index, i);
         assert_int_equal(sh.count, count);
-        assert_int_equal(sh.depth, shard_depth(levels, count));
+        assert_int_equal(sh.depth, shard_depth(levels, build_mean_value_levels(sc, BUILD_INTERVAL), count));
         assert_int_equal(sh.lo, next_lo); /* contiguous ranges */
         next_lo = sh.hi;
         if (i == 0)
@@ -192,7 +216,7 @@ static void check_union(const char *path, unsigned levels, uint32_t count, unsig
         }
         voxels_free(&v);
     }
-    assert_int_equal(next_lo, UINT64_C(1) << (3 * shard_depth(levels, count)));
+    assert_int_equal(next_lo, UINT64_C(1) << (3 * shard_depth(levels, build_mean_value_levels(sc, BUILD_INTERVAL), count)));
     assert_int_equal(at, whole.n);
     voxels_free(&whole);
     scene_free(sc);
@@ -212,7 +236,8 @@ static void test_union_scenes(void **state)
     check_union("scenes/multi.scene", 8, 7, 2);   /* several surfaces */
     check_union("scenes/csg.scene", 8, 3, 1);
     check_union("scenes/blobs_a.scene", 8, 64, 2);
-    check_union("scenes/torus.scene", 4, 5, 1);   /* partition depth 1 */
+    check_union("scenes/torus.scene", 6, 5, 1);   /* partition depth 1 (five mean-value levels) */
+    check_union("scenes/csg.scene", 4, 5, 1);     /* partition depth 1 (three) */
     check_union("scenes/sphere.scene", 3, 2, 1);  /* depth 0: one cell */
     check_union("scenes/sphere.scene", 1, 3, 2);
 }
@@ -222,6 +247,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse),
         cmocka_unit_test(test_depth),
+        cmocka_unit_test(test_mean_value_levels),
         cmocka_unit_test(test_cut),
         cmocka_unit_test(test_union_sphere),
         cmocka_unit_test(test_union_scenes),

@@ -17,18 +17,20 @@ expect_exit 2 "$BIN/rasterize" "$s" -o "$T/p.oct" --shard 0/2 --merge
 expect_err "rasterize: --merge and --shard do not go together"
 [ -e "$T/p.oct" ] && fail "usage errors must not create the output"
 
-# Shards of a 3-way split: each valid, each renders, together all the voxels.
+# Shards of a 3-way split: each valid, each renders, together all the voxels
+# (levels 9: the partition's depth 4 lies above this smooth scene's five
+# mean-value levels).
 total=0
 for i in 0 1 2; do
-    expect_exit 0 "$BIN/rasterize" "$s" -o "$T/p$i.oct" --levels 7 --shard "$i/3"
+    expect_exit 0 "$BIN/rasterize" "$s" -o "$T/p$i.oct" --levels 9 --shard "$i/3"
     grep -q "^rasterize: shard $i/3: cells \[[0-9]*, [0-9]*) of depth 4, " "$OUT" \
         || fail "shard summary: $(cat "$OUT")"
-    n=$(sed -n 's/.* levels 7 (128^3), \([0-9]*\) voxels,.*/\1/p' "$OUT")
+    n=$(sed -n 's/.* levels 9 (512^3), \([0-9]*\) voxels,.*/\1/p' "$OUT")
     [ -n "$n" ] || fail "no voxel count in: $(cat "$OUT")"
     total=$((total + n))
     expect_exit 0 "$BIN/render" "$T/p$i.oct" -o "$T/p$i.png" --size 32x32 -q
 done
-expect_exit 0 "$BIN/rasterize" "$s" -o "$T/whole.oct" --levels 7
-whole=$(sed -n 's/.* levels 7 (128^3), \([0-9]*\) voxels,.*/\1/p' "$OUT")
+expect_exit 0 "$BIN/rasterize" "$s" -o "$T/whole.oct" --levels 9
+whole=$(sed -n 's/.* levels 9 (512^3), \([0-9]*\) voxels,.*/\1/p' "$OUT")
 [ "$total" -eq "$whole" ] || fail "shards hold $total voxels, the whole run $whole"
 pass
