@@ -12,7 +12,7 @@
 
 /* Cells of depth below this (larger than 1/256 of the cube) are too big for
  * a gradient enclosure to be tight: there the plain interval test runs too,
- * and either may drop the cell. From levels 11 (13 for a scene with five
+ * and either may drop the cell. From levels 10 (12 for a scene with five
  * mean-value levels) the mean-value levels are all this deep. */
 #define MEAN_VALUE_ALONE_DEPTH 8
 
