@@ -166,11 +166,16 @@ static int centre_rounding_bounds(build_ctx *c)
     return ok ? 0 : -1;
 }
 
+#define MEAN_VALUE_LEVELS_SMOOTH 5 /* one kink-free surface: pruning barely shortens its tape */
+#define MEAN_VALUE_LEVELS_KINKED 3 /* otherwise: pruning above them decides min, max and abs */
+_Static_assert(MEAN_VALUE_LEVELS_SMOOTH >= 2 && MEAN_VALUE_LEVELS_KINKED >= 2,
+               "leaf-parents reuse their parent's gradient enclosure");
+
 unsigned build_mean_value_levels(const scene *sc, build_method method)
 {
     if (method != BUILD_INTERVAL || sc->nsurfaces != 1 || tape_has_kink(&sc->surfaces[0].tape))
-        return 3;
-    return 5;
+        return MEAN_VALUE_LEVELS_KINKED;
+    return MEAN_VALUE_LEVELS_SMOOTH;
 }
 
 int build_ctx_init(build_ctx *c, const scene *sc, const build_params *p)
